@@ -1,0 +1,11 @@
+#pragma once
+#include "contact/contact_types.h"
+
+namespace dem {
+
+// No cohesion.
+struct CohesionNone {
+  static void apply(const ContactInput&, const PairParams&, ContactResult&) {}
+};
+
+}  // namespace dem

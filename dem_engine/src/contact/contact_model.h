@@ -1,0 +1,60 @@
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "contact/contact_types.h"
+#include "contact/material.h"
+#include "core/domain.h"
+#include "core/neighbor.h"
+#include "core/particles.h"
+
+namespace dem {
+
+// Which sub-models make up the contact law (LIGGGHTS `model hertz tangential history
+// [cohesion sjkr] [rolling_friction epsd2] [surface default]` + keyword/value options).
+struct ModelSpec {
+  bool cohesion_sjkr = false;
+  bool rolling_epsd2 = false;
+  ContactOptions options;
+};
+
+// Parses the model words starting at words[pos]. Stops at the first word that is neither a
+// model type nor a model keyword when `allow_trailing` (wall/gran continues with primitive or
+// mesh), otherwise such a word is an error. Returns the index of the first unparsed word.
+std::size_t parse_model_spec(const std::vector<std::string>& words, std::size_t pos,
+                             ModelSpec& spec, bool allow_trailing);
+
+struct PairForceArgs {
+  Particles& atoms;
+  NeighborList& list;
+  const MaterialTable& material;
+  const Domain& domain;
+  double dt;
+  std::vector<std::vector<Vec3>>& thread_force;   // [thread][particle], zeroed by the callee
+  std::vector<std::vector<Vec3>>& thread_torque;
+  double max_overlap_ratio = 0.0;  // out: largest overlap / smaller radius
+  long max_overlap_tag = -1;       // out: tag of a particle in that contact
+  long contacts = 0;               // out: touching pairs
+};
+
+// The contact law chosen at run time; the per-contact code is composed at compile time from
+// one sub-model per file (normal_hertz.h, tangential_history.h, cohesion_*.h, rolling_*.h).
+class ContactModel {
+ public:
+  explicit ContactModel(ModelSpec spec) : spec_(spec) {}
+  virtual ~ContactModel() = default;
+  const ModelSpec& spec() const { return spec_; }
+  // One contact: updates history (kHistorySize doubles) and fills result.
+  virtual void evaluate(const ContactInput& c, const PairParams& p, double dt, double* history,
+                        ContactResult& result) const = 0;
+  // All particle pairs of the neighbour list; forces/torques summed into f and torque.
+  virtual void pair_forces(PairForceArgs& args) const = 0;
+
+ private:
+  ModelSpec spec_;
+};
+
+std::unique_ptr<ContactModel> make_contact_model(const ModelSpec& spec);
+
+}  // namespace dem

@@ -1,0 +1,11 @@
+#pragma once
+#include "contact/contact_types.h"
+
+namespace dem {
+
+// No rolling resistance.
+struct RollingNone {
+  static void apply(const ContactInput&, const PairParams&, double, double*, ContactResult&) {}
+};
+
+}  // namespace dem

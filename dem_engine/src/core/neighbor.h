@@ -1,0 +1,39 @@
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "contact/contact_types.h"
+#include "core/domain.h"
+#include "core/particles.h"
+
+namespace dem {
+
+// Half neighbour list (each pair once, i < j) from cell binning with a skin. Contact history
+// lives beside the list and survives rebuilds, matched by particle tags.
+class NeighborList {
+ public:
+  double skin = 1e-4;   // neighbor SKIN bin (m)
+  int every = 1;        // neigh_modify every
+  int delay = 0;        // neigh_modify delay
+  bool check = true;    // neigh_modify check yes|no
+
+  std::vector<int> first;         // size n+1: pairs of i are [first[i], first[i+1])
+  std::vector<int> partner;       // j for every pair
+  std::vector<double> history;    // kHistorySize doubles per pair
+
+  // True when a rebuild is due at this step (displacement beyond skin/2, or forced).
+  bool due(const Particles& p, long steps_since_build) const;
+  void force_rebuild() { forced_ = true; }
+  // Rebuilds the list; `extra_cutoff` widens the search (largest radius to be inserted).
+  void build(const Particles& p, const Domain& domain);
+  long builds() const { return builds_; }
+  std::size_t pairs() const { return partner.size(); }
+
+ private:
+  std::vector<Vec3> x_at_build_;
+  std::vector<std::int64_t> tags_at_build_;
+  bool forced_ = true;
+  long builds_ = 0;
+};
+
+}  // namespace dem

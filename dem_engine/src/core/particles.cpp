@@ -1,0 +1,85 @@
+#include "core/particles.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dem {
+
+double sphere_mass(double radius, double density) {
+  return 4.0 / 3.0 * M_PI * radius * radius * radius * density;
+}
+
+double sphere_inertia(double mass, double radius) { return 0.4 * mass * radius * radius; }
+
+std::size_t Particles::add(std::int64_t id, int atom_type, std::uint32_t group_mask,
+                           const Vec3& position, double particle_radius, double particle_density) {
+  tag.push_back(id);
+  type.push_back(atom_type);
+  mask.push_back(group_mask);
+  x.push_back(position);
+  v.emplace_back();
+  f.emplace_back();
+  omega.emplace_back();
+  torque.emplace_back();
+  radius.push_back(particle_radius);
+  density.push_back(particle_density);
+  rmass.push_back(sphere_mass(particle_radius, particle_density));
+  for (auto& e : extras_) e.data.resize(e.data.size() + e.width, 0.0);
+  max_tag_ = std::max(max_tag_, id);
+  return tag.size() - 1;
+}
+
+namespace {
+template <class T>
+void compact(std::vector<T>& values, const std::vector<char>& flagged, std::size_t width = 1) {
+  std::size_t out = 0;
+  const std::size_t n = flagged.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (flagged[i]) continue;
+    if (out != i)
+      for (std::size_t k = 0; k < width; ++k) values[out * width + k] = values[i * width + k];
+    ++out;
+  }
+  values.resize(out * width);
+}
+}  // namespace
+
+void Particles::remove(const std::vector<char>& flagged) {
+  compact(tag, flagged);
+  compact(type, flagged);
+  compact(mask, flagged);
+  compact(x, flagged);
+  compact(v, flagged);
+  compact(f, flagged);
+  compact(omega, flagged);
+  compact(torque, flagged);
+  compact(radius, flagged);
+  compact(rmass, flagged);
+  compact(density, flagged);
+  for (auto& e : extras_) compact(e.data, flagged, e.width);
+}
+
+void Particles::set_radius(std::size_t i, double r) {
+  radius[i] = r;
+  rmass[i] = sphere_mass(r, density[i]);
+}
+
+void Particles::set_density(std::size_t i, double rho) {
+  density[i] = rho;
+  rmass[i] = sphere_mass(radius[i], rho);
+}
+
+long Particles::index_of(std::int64_t id) const {
+  for (std::size_t i = 0; i < tag.size(); ++i)
+    if (tag[i] == id) return static_cast<long>(i);
+  return -1;
+}
+
+std::size_t Particles::register_extra(const std::string& name, std::size_t width) {
+  for (std::size_t h = 0; h < extras_.size(); ++h)
+    if (extras_[h].name == name) return h;
+  extras_.push_back({name, width, std::vector<double>(size() * width, 0.0)});
+  return extras_.size() - 1;
+}
+
+}  // namespace dem

@@ -1,0 +1,273 @@
+// `run`: set-up, the velocity-Verlet step loop and the numerical safety checks.
+#include <omp.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "core/numbers.h"
+#include "core/threads.h"
+#include "core/simulation.h"
+#include "deck/errors.h"
+
+namespace dem {
+
+namespace {
+
+std::string format_g(double v, int precision = 4) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", precision, v);
+  return buf;
+}
+
+// Prints progress to the terminal (stderr), never to the log file that readers parse.
+class Progress {
+ public:
+  Progress(bool enabled, long n_steps) : enabled_(enabled), n_(n_steps) {
+    tty_ = isatty(STDERR_FILENO) != 0;
+    interval_ = tty_ ? 1.0 : 30.0;
+    start_ = last_ = std::chrono::steady_clock::now();
+  }
+  void update(long done, std::size_t particles) {
+    if (!enabled_ || n_ < 1000 || done % 100 != 0) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - last_).count() < interval_) return;
+    last_ = now;
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double rate = done > 0 ? static_cast<double>(done) * particles / elapsed : 0.0;
+    const double eta = done > 0 ? elapsed * (n_ - done) / done : 0.0;
+    std::ostringstream os;
+    os << "run " << format_g(100.0 * done / n_, 3) << "% | " << particles << " particles | "
+       << format_g(rate, 3) << " particle-steps/s | ETA " << format_g(eta, 3) << " s";
+    if (tty_) std::cerr << '\r' << os.str() << "   " << std::flush;
+    else std::cerr << os.str() << '\n';
+  }
+  void finish() {
+    if (enabled_ && tty_ && n_ >= 1000) std::cerr << '\n';
+  }
+
+ private:
+  bool enabled_, tty_ = false;
+  long n_;
+  double interval_;
+  std::chrono::steady_clock::time_point start_, last_;
+};
+
+}  // namespace
+
+void Simulation::compute_forces() {
+  const std::size_t n = atoms.size();
+  std::fill(atoms.f.begin(), atoms.f.end(), Vec3{});
+  std::fill(atoms.torque.begin(), atoms.torque.end(), Vec3{});
+  if (pair && n > 0) {
+    const int nthreads = worker_threads(n);
+    thread_force_.resize(nthreads);
+    thread_torque_.resize(nthreads);
+    for (int t = 0; t < nthreads; ++t) {
+      thread_force_[t].resize(n);
+      thread_torque_[t].resize(n);
+    }
+    PairForceArgs args{atoms, neighbor, material, domain, dt, thread_force_, thread_torque_};
+    pair->pair_forces(args);
+    // Blow-up guard: an overlap of half the smaller radius is never physical here.
+    if (args.max_overlap_ratio > 0.5) {
+      std::ostringstream os;
+      os << "unstable simulation at step " << step << ": particle " << args.max_overlap_tag
+         << " overlaps a neighbour by " << format_g(100.0 * args.max_overlap_ratio, 3)
+         << " % of its radius (time step too large or particles too soft)";
+      throw EngineError(os.str());
+    }
+  }
+  for (auto& f : fixes) f->post_force();
+}
+
+void Simulation::check_health() const {
+  const std::size_t n = atoms.size();
+  double rmin = 1e300;
+  for (double r : atoms.radius) rmin = std::min(rmin, r);
+  // A particle moving more than half its radius in one step cannot be resolved.
+  const double vmax = 0.5 * rmin / dt;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& x = atoms.x[i];
+    const Vec3& v = atoms.v[i];
+    const bool finite = std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z) &&
+                        std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+    if (!finite)
+      throw EngineError("unstable simulation at step " + std::to_string(step) + ": particle " +
+                        std::to_string(atoms.tag[i]) + " has a non-finite position or velocity");
+    const double speed = norm(v);
+    if (speed > vmax)
+      throw EngineError("unstable simulation at step " + std::to_string(step) + ": particle " +
+                        std::to_string(atoms.tag[i]) + " moves at " + format_g(speed) +
+                        " m/s, more than half its radius per time step");
+  }
+}
+
+void Simulation::handle_lost_particles() {
+  std::vector<char> lost(atoms.size(), 0);
+  bool any_lost = false;
+  for (std::size_t i = 0; i < atoms.size(); ++i) {
+    Vec3& x = atoms.x[i];
+    for (int k = 0; k < 3; ++k) {
+      const double lo = domain.lo[k], hi = domain.hi[k];
+      if (domain.periodic(k)) {
+        const double len = hi - lo;
+        while (x[k] < lo) x[k] += len;
+        while (x[k] >= hi) x[k] -= len;
+      } else if (x[k] < lo || x[k] > hi) {
+        if (domain.boundary[k] == 'f') {
+          lost[i] = 1;
+          any_lost = true;
+        } else {  // shrink-wrapped: the box follows the particles
+          domain.lo[k] = std::min(lo, x[k]);
+          domain.hi[k] = std::max(hi, x[k]);
+        }
+      }
+    }
+  }
+  if (!any_lost) return;
+  const long n_lost = std::count(lost.begin(), lost.end(), 1);
+  if (!thermo.lost_ignore)
+    throw EngineError("lost " + std::to_string(n_lost) + " particles through a fixed boundary at step " +
+                      std::to_string(step) + " (use thermo_modify lost ignore to delete them)");
+  atoms.remove(lost);
+  particles_changed();
+}
+
+void Simulation::check_timestep() {
+  if (atoms.size() == 0 && max_radius() == 0.0) return;
+  // Rayleigh time of the smallest particle of each type present (LIGGGHTS check/timestep/gran).
+  double t_rayleigh = 1e300;
+  double rmin = 1e300, rho_of_rmin = 0.0;
+  for (std::size_t i = 0; i < atoms.size(); ++i) {
+    const int t = atoms.type[i];
+    const double y = material.youngs_modulus(t), nu = material.poissons_ratio(t);
+    const double g = y / (2.0 * (1.0 + nu));
+    const double tr = M_PI * atoms.radius[i] * std::sqrt(atoms.density[i] / g) /
+                      (0.1631 * nu + 0.8766);
+    t_rayleigh = std::min(t_rayleigh, tr);
+    if (atoms.radius[i] < rmin) {
+      rmin = atoms.radius[i];
+      rho_of_rmin = atoms.density[i];
+    }
+  }
+  if (atoms.size() == 0) return;
+  // Hertz contact time at the largest expected impact speed: particle and wall speeds, and a
+  // free fall over the box height.
+  double vmax = 0.0;
+  for (const Vec3& v : atoms.v) vmax = std::max(vmax, norm(v));
+  for (const auto& f : fixes) vmax = std::max(vmax, f->max_wall_speed());
+  vmax = std::max(vmax, std::sqrt(2.0 * 9.81 * (domain.hi.z - domain.lo.z)));
+  const double y = material.youngs_modulus(atoms.type[0]), nu = material.poissons_ratio(atoms.type[0]);
+  const double y_star = y / (2.0 * (1.0 - nu * nu));
+  const double r_star = 0.5 * rmin, m_star = 0.5 * 4.0 / 3.0 * M_PI * rmin * rmin * rmin * rho_of_rmin;
+  const double t_hertz =
+      2.87 * std::pow(m_star * m_star / (r_star * y_star * y_star * vmax), 0.2);
+  std::ostringstream os;
+  os << "time step " << format_g(dt) << " s = " << format_g(100.0 * dt / t_rayleigh, 3)
+     << " % of the Rayleigh time and " << format_g(100.0 * dt / t_hertz, 3)
+     << " % of the Hertz time (impact speed " << format_g(vmax, 3) << " m/s)";
+  if (log_.is_open()) log_ << os.str() << '\n';
+  if (dt > 0.2 * t_rayleigh || dt > 0.2 * t_hertz)
+    warning(os.str() + ": above 20 %, the simulation may be inaccurate or unstable");
+}
+
+void Simulation::setup_run() {
+  if (!domain.defined) throw EngineError("run before create_box");
+  if (!pair) throw EngineError("run before pair_style gran");
+  material.build(properties, ntypes, soft_particles, pair->spec().rolling_epsd2,
+                 pair->spec().cohesion_sjkr);
+  for (auto& f : fixes) f->init();
+  handle_lost_particles();
+  check_timestep();
+  neighbor.force_rebuild();
+  neighbor.build(atoms, domain);
+  last_build_step_ = step;
+  compute_forces();
+  for (auto& f : fixes) f->setup();
+}
+
+void Simulation::integrate_step() {
+  ++step;
+  time += dt;
+  for (auto& f : fixes) f->initial_integrate();
+  for (auto& f : fixes) f->post_integrate();
+  for (auto& f : fixes) f->pre_exchange();
+  if (neighbor.due(atoms, step - last_build_step_)) {
+    handle_lost_particles();
+    neighbor.build(atoms, domain);
+    last_build_step_ = step;
+  }
+  compute_forces();
+  for (auto& f : fixes) f->final_integrate();
+  for (auto& f : fixes) f->end_of_step();
+}
+
+void Simulation::run(const Command& command) {
+  const auto& a = command.args;
+  require_args(a, 1, "run N [upto] [every M \"command\" ...]");
+  long n = parse_int(a[0], "run N");
+  std::size_t k = 1;
+  long every = 0;
+  std::vector<std::string> every_commands;
+  while (k < a.size()) {
+    if (a[k] == "upto") {
+      n -= step;
+      ++k;
+    } else if (a[k] == "every") {
+      if (k + 1 >= a.size()) throw EngineError("run every needs M and commands");
+      every = parse_int(a[k + 1], "run every M");
+      if (every <= 0) throw EngineError("run every M must be > 0");
+      every_commands.assign(a.begin() + k + 2, a.end());
+      if (every_commands.size() == 1 && every_commands[0] == "NULL") every_commands.clear();
+      k = a.size();
+    } else if ((a[k] == "pre" || a[k] == "post") && k + 1 < a.size()) {
+      parse_yes_no(a[k + 1], a[k]);
+      k += 2;
+    } else {
+      throw EngineError("unknown run keyword '" + a[k] + "'");
+    }
+  }
+  if (n < 0) throw EngineError("run length is negative");
+  // `run N every M cmds`: N/M chained runs of M steps with the commands after each.
+  const long chunk = every > 0 ? every : n;
+  long remaining = n;
+  do {
+    const long this_run = std::min(chunk, remaining);
+    run_start_step = step;
+    run_end_step = step + this_run;
+    setup_run();
+    thermo.header(*this);
+    thermo.row(*this);
+    for (auto& d : dumps) d->write();
+    Progress progress(options_.progress, this_run);
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long s = 0; s < this_run; ++s) {
+      integrate_step();
+      if (step % 10 == 0 || s + 1 == this_run) check_health();
+      const bool last = step == run_end_step;
+      if ((thermo.every > 0 && step % thermo.every == 0) || last) thermo.row(*this);
+      for (auto& d : dumps)
+        if (d->every() > 0 && step % d->every() == 0) d->write();
+      progress.update(s + 1, atoms.size());
+    }
+    progress.finish();
+    for (auto& f : fixes) f->post_run();
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::ostringstream os;
+    os << "Loop time of " << format_g(secs, 6) << " on " << omp_get_max_threads()
+       << " threads for " << this_run << " steps with " << atoms.size() << " atoms";
+    if (secs > 0 && this_run > 0)
+      os << " (" << format_g(static_cast<double>(this_run) * atoms.size() / secs, 4)
+         << " particle-steps/s, " << neighbor.builds() << " neighbour builds)";
+    message(os.str());
+    remaining -= this_run;
+    if (every > 0)
+      for (const auto& c : every_commands) input().run_line(c, command.where);
+  } while (remaining > 0);
+}
+
+}  // namespace dem

@@ -1,0 +1,120 @@
+#pragma once
+#include <chrono>
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "contact/contact_model.h"
+#include "contact/material.h"
+#include "core/compute.h"
+#include "core/domain.h"
+#include "core/groups.h"
+#include "core/neighbor.h"
+#include "core/particles.h"
+#include "core/properties.h"
+#include "core/region.h"
+#include "core/thermo.h"
+#include "deck/eval_context.h"
+#include "deck/input.h"
+#include "deck/variables.h"
+#include "fix/fix.h"
+#include "io/dump.h"
+
+namespace dem {
+
+struct EngineOptions {
+  std::string log_file = "log.liggghts";  // "none" disables the log
+  bool echo_screen = false;
+  bool progress = true;
+};
+
+// The whole state of one simulation and the command table that changes it.
+class Simulation : public CommandHandler, public EvalContext {
+ public:
+  explicit Simulation(EngineOptions options);
+  ~Simulation() override;
+
+  // --- state -----------------------------------------------------------------------------
+  Particles atoms;
+  Domain domain;
+  Groups groups;
+  PropertyStore properties;
+  MaterialTable material;
+  NeighborList neighbor;
+  Variables variables;
+  std::map<std::string, std::unique_ptr<Region>> regions;
+  std::vector<std::unique_ptr<Fix>> fixes;
+  std::vector<std::unique_ptr<Compute>> computes;
+  std::vector<std::unique_ptr<Dump>> dumps;
+  std::unique_ptr<ContactModel> pair;  // pair_style gran; null until defined
+  Thermo thermo;
+
+  int ntypes = 0;               // atom types from create_box
+  double dt = 1e-5;             // timestep (s)
+  long step = 0;                // current step
+  double time = 0.0;            // simulated time (s)
+  bool soft_particles = false;
+  long run_start_step = 0, run_end_step = 0;  // of the current run
+
+  // --- services for fixes, computes and dumps -----------------------------------------------
+  Region& region(const std::string& id);                 // throws naming the id
+  Fix* find_fix(const std::string& id) const;            // nullptr if absent
+  Fix& fix(const std::string& id) const;                 // throws naming the id
+  Compute& compute(const std::string& id) const;         // throws naming the id
+  // Must be called after particles are added or removed (neighbour list, caches).
+  void particles_changed();
+  // Largest radius of existing particles and of particles any fix may insert.
+  double max_radius() const;
+  // Writes to the screen and the log file.
+  void message(const std::string& text) override;
+  void warning(const std::string& text);
+  std::ofstream* log_stream() { return log_.is_open() ? &log_ : nullptr; }
+  Input& input() { return *input_; }
+  // Evaluates a contact between particle i and a wall/mesh surface (walls reuse the pair model).
+  // `wall_type` is the atom type of the wall material; `history` holds kHistorySize doubles.
+  void wall_contact(std::size_t i, const Vec3& normal, double overlap, double dist,
+                    const Vec3& wall_velocity, int wall_type, double* history,
+                    ContactResult& result) const;
+  const ContactModel& pair_model() const;  // throws if no pair_style
+
+  // --- deck interface -------------------------------------------------------------------------
+  void run_deck(const std::string& path, const std::vector<std::pair<std::string,
+                std::vector<std::string>>>& command_line_vars);
+  void execute(const Command& command) override;
+  void open_log(const std::string& path, bool append) override;
+  const EvalContext& eval_context() const override { return *this; }
+
+  // --- EvalContext ----------------------------------------------------------------------------
+  std::optional<double> thermo_keyword(const std::string& name) const override;
+  double group_function(const std::string& function,
+                        const std::vector<std::string>& args) const override;
+  double compute_value(const std::string& id, int index) const override;
+  double fix_value(const std::string& id, int index) const override;
+
+  double kinetic_energy(std::uint32_t group_bit) const;  // translational (J)
+  double cpu_seconds() const;
+
+ private:
+  void run(const Command& command);
+  void setup_run();
+  void integrate_step();
+  void compute_forces();
+  void check_timestep();
+  void check_health() const;
+  void handle_lost_particles();
+
+  EngineOptions options_;
+  std::unique_ptr<Input> input_;
+  std::ofstream log_;
+  std::chrono::steady_clock::time_point wall_start_;
+  long last_build_step_ = 0;
+  std::vector<std::vector<Vec3>> thread_force_, thread_torque_;
+  bool lost_ignore_ = false;
+};
+
+}  // namespace dem

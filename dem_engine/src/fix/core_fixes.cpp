@@ -1,0 +1,125 @@
+// Fix styles of the core: material properties, gravity, integration, freezing.
+#include <cmath>
+#include <memory>
+
+#include "core/numbers.h"
+#include "core/threads.h"
+#include "core/simulation.h"
+#include "deck/errors.h"
+#include "fix/fix.h"
+
+namespace dem {
+namespace {
+
+// fix ID all property/global NAME STYLE args: stores a global material property.
+class FixPropertyGlobal : public Fix {
+ public:
+  FixPropertyGlobal(Simulation& sim, const Command& c) : Fix(sim, c) {
+    const auto& a = args();
+    require_args(a, 3, "fix ID all property/global NAME scalar|vector|peratomtype|peratomtypepair|matrix values...");
+    GlobalProperty p;
+    p.style = a[1];
+    std::size_t first_value = 2;
+    if (p.style == "peratomtypepair" || p.style == "matrix") {
+      p.n = static_cast<int>(parse_int(a[2], a[0] + " matrix size"));
+      if (p.n < 1) throw EngineError(a[0] + ": matrix size must be >= 1");
+      first_value = 3;
+    } else if (p.style != "scalar" && p.style != "vector" && p.style != "peratomtype") {
+      throw EngineError("unknown property/global style '" + p.style + "'");
+    }
+    for (std::size_t i = first_value; i < a.size(); ++i)
+      p.values.push_back(parse_double(a[i], a[0] + " value " + std::to_string(i - first_value + 1)));
+    if (p.values.empty()) throw EngineError(a[0] + ": no values given");
+    if (p.n > 0 && static_cast<int>(p.values.size()) != p.n * p.n)
+      throw EngineError(a[0] + ": a " + std::to_string(p.n) + "x" + std::to_string(p.n) +
+                        " matrix needs " + std::to_string(p.n * p.n) + " values, got " +
+                        std::to_string(p.values.size()));
+    if (p.style == "scalar" && p.values.size() != 1)
+      throw EngineError(a[0] + ": scalar takes one value");
+    sim.properties.set(a[0], p, id());
+  }
+};
+
+// fix ID group gravity G vector X Y Z
+class FixGravity : public Fix {
+ public:
+  FixGravity(Simulation& sim, const Command& c) : Fix(sim, c) {
+    const auto& a = args();
+    if (a.size() != 5 || a[1] != "vector")
+      throw EngineError("usage: fix ID group gravity MAGNITUDE vector X Y Z");
+    const double g = parse_double(a[0], "gravity magnitude");
+    const Vec3 dir{parse_double(a[2], "x"), parse_double(a[3], "y"), parse_double(a[4], "z")};
+    const double len = norm(dir);
+    if (len == 0.0) throw EngineError("gravity direction is zero");
+    accel_ = (g / len) * dir;
+  }
+  void post_force() override {
+    auto& P = sim_.atoms;
+    const std::uint32_t bit = group_bit();
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.mask[i] & bit) P.f[i] += P.rmass[i] * accel_;
+  }
+  const Vec3& acceleration() const { return accel_; }
+
+ private:
+  Vec3 accel_;
+};
+
+// fix ID group nve/sphere: velocity Verlet for translation and rotation of spheres.
+class FixNveSphere : public Fix {
+ public:
+  FixNveSphere(Simulation& sim, const Command& c) : Fix(sim, c) {
+    if (!args().empty()) throw EngineError("fix nve/sphere takes no arguments here");
+  }
+  void initial_integrate() override { kick(true); }
+  void final_integrate() override { kick(false); }
+
+ private:
+  void kick(bool drift) {
+    auto& P = sim_.atoms;
+    const double dt = sim_.dt, half = 0.5 * dt;
+    const std::uint32_t bit = group_bit();
+    const std::size_t n = P.size();
+#pragma omp parallel for schedule(static) num_threads(worker_threads(n))
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!(P.mask[i] & bit)) continue;
+      const double inv_m = 1.0 / P.rmass[i];
+      const double inv_i = 1.0 / sphere_inertia(P.rmass[i], P.radius[i]);
+      P.v[i] += (half * inv_m) * P.f[i];
+      P.omega[i] += (half * inv_i) * P.torque[i];
+      if (drift) P.x[i] += dt * P.v[i];
+    }
+  }
+};
+
+// fix ID group freeze: zero force and torque on the group (LAMMPS semantics).
+class FixFreeze : public Fix {
+ public:
+  FixFreeze(Simulation& sim, const Command& c) : Fix(sim, c) {
+    if (!args().empty()) throw EngineError("fix freeze takes no arguments");
+  }
+  void post_force() override {
+    auto& P = sim_.atoms;
+    for (std::size_t i = 0; i < P.size(); ++i)
+      if (P.mask[i] & group_bit()) {
+        P.f[i] = Vec3{};
+        P.torque[i] = Vec3{};
+      }
+  }
+};
+
+template <class T>
+FixFactory factory() {
+  return [](Simulation& s, const Command& c) { return std::make_unique<T>(s, c); };
+}
+
+}  // namespace
+
+void register_core_fix_styles(FixRegistry& r) {
+  r["property/global"] = factory<FixPropertyGlobal>();
+  r["gravity"] = factory<FixGravity>();
+  r["nve/sphere"] = factory<FixNveSphere>();
+  r["freeze"] = factory<FixFreeze>();
+}
+
+}  // namespace dem

@@ -1,0 +1,89 @@
+#include "mesh/tri_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "deck/errors.h"
+
+namespace dem {
+
+TriMesh::TriMesh(const std::vector<Triangle>& triangles, const std::string& source) {
+  if (triangles.empty()) throw EngineError("mesh from " + source + " has no triangles");
+  nodes_.reserve(3 * triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& v = triangles[t].v;
+    // Zero-area facets have no normal; relative to the longest edge so the test is unit-free.
+    const double longest = std::max({norm(v[1] - v[0]), norm(v[2] - v[1]), norm(v[0] - v[2])});
+    if (!(triangle_area(v[0], v[1], v[2]) > 1e-12 * longest * longest))
+      throw EngineError("mesh from " + source + ": triangle " + std::to_string(t + 1) +
+                        " is degenerate (zero area)");
+    for (const Vec3& p : v) nodes_.push_back(p);
+  }
+  velocities_.assign(nodes_.size(), Vec3{});
+}
+
+std::vector<Triangle> TriMesh::triangles() const {
+  std::vector<Triangle> out(size());
+  for (std::size_t t = 0; t < out.size(); ++t)
+    for (int k = 0; k < 3; ++k) out[t].v[k] = node(t, k);
+  return out;
+}
+
+void TriMesh::scale(double factor) {
+  for (Vec3& p : nodes_) p *= factor;
+  ++version_;
+}
+
+void TriMesh::translate(const Vec3& d, std::size_t first_frame) {
+  for (Vec3& p : nodes_) p += d;
+  for (std::size_t k = first_frame; k < frames_.size(); ++k) frames_[k].origin += d;
+  ++version_;
+}
+
+void TriMesh::rotate(const Vec3& unit_axis, double angle, const Vec3& center,
+                     std::size_t first_frame) {
+  for (Vec3& p : nodes_) p = center + rotate_about_axis(p - center, unit_axis, angle);
+  for (std::size_t k = first_frame; k < frames_.size(); ++k) {
+    frames_[k].origin = center + rotate_about_axis(frames_[k].origin - center, unit_axis, angle);
+    frames_[k].axis = rotate_about_axis(frames_[k].axis, unit_axis, angle);
+  }
+  ++version_;
+}
+
+void TriMesh::clear_velocities() {
+  std::fill(velocities_.begin(), velocities_.end(), Vec3{});
+  moving_ = false;
+}
+
+void TriMesh::add_velocity(const Vec3& v) {
+  for (Vec3& u : velocities_) u += v;
+  moving_ = true;
+}
+
+void TriMesh::add_rotation_velocity(const Vec3& omega, const Vec3& origin) {
+  for (std::size_t k = 0; k < nodes_.size(); ++k) velocities_[k] += cross(omega, nodes_[k] - origin);
+  moving_ = true;
+}
+
+double TriMesh::max_node_speed() const {
+  double v2 = 0.0;
+  for (const Vec3& u : velocities_) v2 = std::max(v2, norm2(u));
+  return std::sqrt(v2);
+}
+
+std::size_t TriMesh::add_frame(const Vec3& origin, const Vec3& axis) {
+  frames_.push_back({origin, axis});
+  return frames_.size() - 1;
+}
+
+void TriMesh::bounding_box(Vec3& lo, Vec3& hi) const {
+  lo = Vec3{1e300, 1e300, 1e300};
+  hi = Vec3{-1e300, -1e300, -1e300};
+  for (const Vec3& p : nodes_)
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], p[d]);
+      hi[d] = std::max(hi[d], p[d]);
+    }
+}
+
+}  // namespace dem

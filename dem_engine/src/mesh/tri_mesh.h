@@ -1,0 +1,70 @@
+#pragma once
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/vec3.h"
+#include "mesh/stl_io.h"
+#include "mesh/triangle_geometry.h"
+
+namespace dem {
+
+// A rigid triangle surface mesh: three nodes per triangle (no shared node table, the STL
+// "triangle soup"), a velocity per node for moving walls, and reference frames that move with
+// the mesh (the origins and axes of superposed motions).
+class TriMesh {
+ public:
+  TriMesh() = default;
+  // Throws EngineError naming `source` when a triangle has (nearly) zero area.
+  TriMesh(const std::vector<Triangle>& triangles, const std::string& source);
+
+  std::size_t size() const { return nodes_.size() / 3; }
+  const Vec3& node(std::size_t tri, int k) const { return nodes_[3 * tri + k]; }
+  const std::vector<Vec3>& nodes() const { return nodes_; }
+  std::vector<Triangle> triangles() const;
+
+  // Closest point of triangle `tri` to p.
+  ClosestPoint closest_point(std::size_t tri, const Vec3& p) const {
+    return closest_point_on_triangle(p, nodes_[3 * tri], nodes_[3 * tri + 1], nodes_[3 * tri + 2]);
+  }
+  // Velocity of the surface at a point given by barycentric weights (m/s). Exact for rigid
+  // motions, whose velocity field is affine in the position.
+  Vec3 velocity_at(std::size_t tri, const ClosestPoint& cp) const {
+    const Vec3* v = &velocities_[3 * tri];
+    return cp.wa * v[0] + cp.wb * v[1] + cp.wc * v[2];
+  }
+  bool moving() const { return moving_; }
+
+  // Set-up transformations (mesh/surface keywords): about the origin, as LIGGGHTS does.
+  void scale(double factor);
+  // Rigid motions. Frames with index >= first_frame move along (see add_frame).
+  void translate(const Vec3& d, std::size_t first_frame = 0);
+  void rotate(const Vec3& unit_axis, double angle, const Vec3& center, std::size_t first_frame = 0);
+
+  // Node velocities: cleared at every step, then each motion adds its own part.
+  void clear_velocities();
+  void add_velocity(const Vec3& v);
+  void add_rotation_velocity(const Vec3& omega, const Vec3& origin);
+  double max_node_speed() const;
+
+  // A point and a direction carried along by the motions that act on the mesh before the owner
+  // of the frame (superposition of move/mesh: later motions live in the moving frame).
+  struct Frame {
+    Vec3 origin, axis;
+  };
+  std::size_t add_frame(const Vec3& origin, const Vec3& axis);
+  const Frame& frame(std::size_t k) const { return frames_[k]; }
+
+  // Counts rigid motions, so that users can tell whether the nodes changed.
+  long version() const { return version_; }
+  void bounding_box(Vec3& lo, Vec3& hi) const;
+
+ private:
+  std::vector<Vec3> nodes_;
+  std::vector<Vec3> velocities_;
+  std::vector<Frame> frames_;
+  long version_ = 0;
+  bool moving_ = false;
+};
+
+}  // namespace dem

@@ -1,0 +1,37 @@
+#pragma once
+#include "core/vec3.h"
+
+namespace dem {
+
+// Which feature of a triangle (a, b, c) holds the point closest to a query point.
+enum class TriRegion : unsigned char {
+  kFace,     // interior of the face
+  kEdgeAB,   // interior of edge a-b
+  kEdgeBC,   // interior of edge b-c
+  kEdgeCA,   // interior of edge c-a
+  kVertexA,
+  kVertexB,
+  kVertexC,
+};
+
+// Closest point of a triangle to a query point, with its barycentric weights (wa + wb + wc = 1)
+// so that node quantities (e.g. velocities) can be interpolated at that point.
+struct ClosestPoint {
+  Vec3 point;
+  double wa = 1.0, wb = 0.0, wc = 0.0;
+  TriRegion region = TriRegion::kVertexA;
+  bool on_face() const { return region == TriRegion::kFace; }
+};
+
+// Closest point on the (closed) triangle a, b, c to p, classified by Voronoi region of the
+// triangle's features. Degenerate triangles are handled (the result is a point of a segment).
+ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+// Unit normal (b - a) x (c - a) / |...|; the zero vector for a degenerate triangle.
+Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
+double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);
+
+// Rotates v by `angle` (rad) about the unit axis `unit_axis` through the origin (right hand).
+Vec3 rotate_about_axis(const Vec3& v, const Vec3& unit_axis, double angle);
+
+}  // namespace dem

@@ -1,0 +1,18 @@
+#!/usr/bin/env bash
+# Installs the Debian packages that off-screen rendering (pyvista/VTK with EGL) needs, if missing.
+set -euo pipefail
+packages=(libegl1 libegl-mesa0 libgl1-mesa-dri)
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+echo "installing Debian packages for off-screen rendering: ${missing[*]}"
+if [ "$(id -u)" -eq 0 ]; then
+    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}"
+elif command -v sudo >/dev/null 2>&1; then
+    sudo apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}"
+else
+    echo "ERROR: missing Debian packages ${missing[*]}; install them as root" >&2
+    exit 1
+fi
