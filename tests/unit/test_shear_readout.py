@@ -1,0 +1,268 @@
+"""Shear-cell readouts on synthetic print tables built from a known mu(t), rho_b and load."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from demcal.engine_output import MissingColumnError, read_print_file
+from demcal.shear_readout import (
+    REQUIRED_COLUMNS,
+    overlap_area,
+    shear_cell_bulk_values,
+    shear_stress_series,
+)
+
+R = 0.02  # cell radius, m
+Z_FLOOR = 0.0
+Z_SHEAR = 0.015
+G = 9.81
+AREA = np.pi * R**2
+V_WALL = 3 * 0.732e-3  # m/s
+DT_PRINT = 2e-3  # s
+T_PRE = 0.1875 * R / V_WALL  # pre-shear duration, s
+T_SHEAR = 0.95 * T_PRE
+
+
+# ---------------------------------------------------------------------------- overlap area
+
+
+def test_overlap_area_known_values() -> None:
+    assert overlap_area(R, 0.0) == pytest.approx(np.pi * R**2, rel=1e-14)
+    # Centres one radius apart: lens area R^2 (2 pi / 3 - sqrt(3) / 2).
+    assert overlap_area(R, R) == pytest.approx(R**2 * (2 * np.pi / 3 - np.sqrt(3) / 2), rel=1e-13)
+    assert overlap_area(R, -R) == overlap_area(R, R)
+    assert overlap_area(R, 2 * R) == 0.0
+    assert overlap_area(R, 3 * R) == 0.0
+    d = np.linspace(0.0, 2 * R, 11)
+    a = overlap_area(R, d)
+    assert a.shape == d.shape
+    assert np.all(np.diff(a) < 0.0)
+
+
+def test_overlap_area_matches_grid_count() -> None:
+    n = 1601
+    x = np.linspace(-R, 3 * R, n)
+    y = np.linspace(-R, R, n // 2)
+    cell = (x[1] - x[0]) * (y[1] - y[0])
+    xx, yy = np.meshgrid(x, y)
+    in_first = xx**2 + yy**2 <= R**2
+    for d in (0.1 * R, 0.73 * R, 1.5 * R):
+        count = np.count_nonzero(in_first & ((xx - d) ** 2 + yy**2 <= R**2))
+        assert overlap_area(R, d) == pytest.approx(count * cell, rel=3e-3)
+
+
+def test_overlap_area_slope_is_minus_chord_length() -> None:
+    # dA/dd = -(chord of the lens) = -sqrt(4R^2 - d^2).
+    for d in (0.2 * R, R, 1.7 * R):
+        h = 1e-7 * R
+        slope = (overlap_area(R, d + h) - overlap_area(R, d - h)) / (2 * h)
+        assert slope == pytest.approx(-np.sqrt(4 * R**2 - d**2), rel=1e-6)
+
+
+def test_overlap_area_rejects_bad_radius() -> None:
+    with pytest.raises(ValueError, match="radius"):
+        overlap_area(0.0, 0.01)
+
+
+# ------------------------------------------------------------------------ synthetic run
+
+
+def _phase_times(t0: float, duration: float) -> np.ndarray:
+    return t0 + np.arange(0.0, duration, DT_PRINT)
+
+
+def synthetic_run(
+    cycles: list[dict[str, float]],
+    seed: int = 0,
+    stop_time: float | None = None,
+) -> pd.DataFrame:
+    """Print table of a shear-cell run whose mu(t) is known.
+
+    Each cycle dict holds normal_stress (Pa), P, mu_psh, mu_sh and rho_b (kg/m^3). The mass in
+    the cell is fixed; a cycle's rho_b sets its lid height. The shear force is built as mu(t)
+    times (lid force + weight above the shear plane), so the readout must return mu(t) up to
+    the added noise.
+    """
+    rng = np.random.default_rng(seed)
+    mass = 1760.0 * AREA * 0.03
+    parts = []
+    settle = _phase_times(0.0, 0.1)
+    target0 = cycles[0]["normal_stress"] * AREA
+    parts.append(
+        pd.DataFrame(
+            {
+                "time": settle,
+                "phase": 0,
+                "cycle": 0,
+                "lid_z": 0.031,
+                "lid_force": 0.9 * target0,
+                "shear_force": 0.0,
+                "travel": 0.0,
+                "target_force": target0,
+            }
+        )
+    )
+    t = settle[-1] + DT_PRINT
+    for c, spec in enumerate(cycles):
+        lid_height = Z_FLOOR + mass / (spec["rho_b"] * AREA)
+        target = spec["normal_stress"] * AREA
+        t_start = t
+        for phase, duration, load, level in (
+            (1, T_PRE, target, spec["mu_psh"]),
+            (2, 0.05, 0.001 * target, 0.0),
+            (3, T_SHEAR, spec["P"] * target, spec["mu_sh"]),
+        ):
+            times = _phase_times(t, duration)
+            n = times.size
+            lid_z = lid_height + 2e-6 * rng.standard_normal(n)
+            lid_force = load * (1.0 + 0.02 * rng.standard_normal(n))
+            weight = mass * G * (lid_z - Z_SHEAR) / (lid_z - Z_FLOOR)
+            if phase == 2:
+                mu = np.zeros(n)
+                travel = np.full(n, -V_WALL * (times[0] - t_start))
+            else:
+                # Rise with time constant 0.1 s, then noise about the level.
+                mu = level * (1.0 - np.exp(-(times - t) / 0.1)) + 0.01 * rng.standard_normal(n)
+                travel = -V_WALL * (times - t_start)
+            parts.append(
+                pd.DataFrame(
+                    {
+                        "time": times,
+                        "phase": phase,
+                        "cycle": c,
+                        "lid_z": lid_z,
+                        "lid_force": lid_force,
+                        "shear_force": -mu * (lid_force + weight),
+                        "travel": travel,
+                        "target_force": load,
+                    }
+                )
+            )
+            t = times[-1] + DT_PRINT
+    table = pd.concat(parts, ignore_index=True)
+    table["mass"] = mass
+    table.insert(0, "step", np.round(table["time"] / 1e-6).astype(np.int64))
+    if stop_time is not None:
+        table = table[table["time"] <= stop_time].reset_index(drop=True)
+    return table
+
+
+CYCLES = [
+    {"normal_stress": 2029.0, "P": 0.6, "mu_psh": 0.55, "mu_sh": 0.42, "rho_b": 1760.0},
+    {"normal_stress": 2029.0, "P": 1.0, "mu_psh": 0.57, "mu_sh": 0.56, "rho_b": 1790.0},
+]
+
+
+def test_stress_series_by_hand() -> None:
+    # One row with round numbers: rho_b = 1500 kg/m^3 by construction.
+    lid_z, travel, lid_force, shear = 0.03, 0.004, 10.0, -6.0
+    row = pd.DataFrame(
+        {
+            "time": [1.0],
+            "phase": [1],
+            "cycle": [0],
+            "lid_z": [lid_z],
+            "lid_force": [lid_force],
+            "shear_force": [shear],
+            "travel": [travel],
+            "mass": [1500.0 * AREA * lid_z],
+            "target_force": [10.0],
+        }
+    )
+    out = shear_stress_series(row, R, Z_FLOOR, Z_SHEAR, G).iloc[0]
+    area = 2 * R**2 * np.arccos(travel / (2 * R)) - travel / 2 * np.sqrt(4 * R**2 - travel**2)
+    weight = 1500.0 * G * AREA * (lid_z - Z_SHEAR)
+    assert out["rho_b"] == pytest.approx(1500.0, rel=1e-12)
+    assert out["area"] == pytest.approx(area, rel=1e-12)
+    assert out["sigma"] == pytest.approx((lid_force + weight) / area, rel=1e-12)
+    assert out["tau"] == pytest.approx(6.0 / area, rel=1e-12)
+    assert out["mu"] == pytest.approx(6.0 / (lid_force + weight), rel=1e-12)
+
+
+def test_bulk_values_recovered_per_cycle() -> None:
+    table = synthetic_run(CYCLES, seed=1)
+    got = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
+    assert list(got["cycle"]) == [0, 1]
+    for (_, row), spec in zip(got.iterrows(), CYCLES, strict=True):
+        assert row["P"] == pytest.approx(spec["P"], rel=1e-12)
+        assert row["normal_stress"] == pytest.approx(spec["normal_stress"], rel=1e-12)
+        assert row["mu_psh"] == pytest.approx(spec["mu_psh"], abs=0.005)
+        assert row["mu_sh"] == pytest.approx(spec["mu_sh"], abs=0.005)
+        assert row["rho_b"] == pytest.approx(spec["rho_b"], rel=1e-3)
+        assert row["steady_psh"] and row["steady_sh"]
+        # The plateau excludes the rise (time constant 0.1 s) and runs to the phase end.
+        pre = table[(table["cycle"] == row["cycle"]) & (table["phase"] == 1)]["time"]
+        assert row["psh_t_start"] > pre.iloc[0] + 0.3
+        assert row["psh_t_end"] == pytest.approx(pre.iloc[-1])
+        assert row["mu_psh_sem"] < 0.003
+
+
+def test_weight_of_the_column_enters_sigma() -> None:
+    # Ignoring gravity in the readout raises mu by (lid force + weight) / lid force.
+    table = synthetic_run(CYCLES[:1], seed=2)
+    with_g = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
+    without_g = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, g=0.0)
+    weight = 1760.0 * G * AREA * (0.03 - Z_SHEAR)
+    lid = 2029.0 * AREA
+    ratio = without_g["mu_psh"].iloc[0] / with_g["mu_psh"].iloc[0]
+    assert ratio == pytest.approx((lid + weight) / lid, rel=2e-3)
+
+
+def test_interrupted_run_flags_unsteady_and_missing_phases() -> None:
+    spec = {"normal_stress": 10070.0, "P": 0.8, "mu_psh": 0.5, "mu_sh": 0.45, "rho_b": 1800.0}
+    full = synthetic_run([spec, spec], seed=3)
+    shear1 = full[(full["cycle"] == 1) & (full["phase"] == 3)]["time"]
+    # Stop 0.08 s into the shear of cycle 1: mu is still rising (time constant 0.1 s).
+    cut = synthetic_run([spec, spec], seed=3, stop_time=float(shear1.iloc[0]) + 0.08)
+    got = shear_cell_bulk_values(cut, R, Z_FLOOR, Z_SHEAR, G)
+    assert got["steady_psh"].tolist() == [True, True]
+    assert got["steady_sh"].tolist() == [True, False]
+    assert got["mu_sh"].iloc[1] < 0.45 * 0.8
+    # Stopped during the unload of cycle 1: no shear phase at all.
+    unload1 = full[(full["cycle"] == 1) & (full["phase"] == 2)]["time"]
+    cut2 = synthetic_run([spec, spec], seed=3, stop_time=float(unload1.iloc[2]))
+    got2 = shear_cell_bulk_values(cut2, R, Z_FLOOR, Z_SHEAR, G)
+    assert np.isnan(got2["mu_sh"].iloc[1])
+    assert np.isnan(got2["P"].iloc[1])
+    assert not got2["steady_sh"].iloc[1]
+    assert got2["sh_reason"].iloc[1] == "no shear phase"
+    assert got2["mu_psh"].iloc[1] == pytest.approx(0.5, abs=0.005)
+
+
+def test_from_print_file(tmp_path: Path) -> None:
+    table = synthetic_run(CYCLES, seed=4)[["step", *REQUIRED_COLUMNS]]
+    path = tmp_path / "shear.print"
+    lines = ["# " + " ".join(table.columns)]
+    lines += [" ".join(f"{v:.10g}" for v in row) for row in table.to_numpy(dtype=float)]
+    path.write_text("\n".join(lines) + "\n")
+    from_file = shear_cell_bulk_values(read_print_file(path), R, Z_FLOOR, Z_SHEAR, G)
+    direct = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
+    for col in ("P", "normal_stress", "mu_psh", "mu_sh", "rho_b"):
+        np.testing.assert_allclose(from_file[col], direct[col], rtol=1e-6)
+
+
+def test_plateau_options_are_passed_on() -> None:
+    table = synthetic_run(CYCLES[:1], seed=5)
+    strict = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G, min_fraction=0.9)
+    # A plateau covering 90 % of the phase would include the rise, so it is not steady.
+    assert not strict["steady_psh"].iloc[0]
+
+
+def test_bad_tables_raise_clear_errors() -> None:
+    table = synthetic_run(CYCLES[:1], seed=6)
+    with pytest.raises(MissingColumnError, match="target_force"):
+        shear_cell_bulk_values(table.drop(columns="target_force"), R, Z_FLOOR, Z_SHEAR)
+    low = table.copy()
+    low.loc[low["phase"] == 1, "lid_z"] = Z_SHEAR - 0.001
+    with pytest.raises(ValueError, match="lid_z"):
+        shear_cell_bulk_values(low, R, Z_FLOOR, Z_SHEAR)
+    holes = table.copy()
+    holes.loc[5, "lid_force"] = np.nan
+    with pytest.raises(ValueError, match="lid_force"):
+        shear_cell_bulk_values(holes, R, Z_FLOOR, Z_SHEAR)
+    with pytest.raises(ValueError, match="z_shear"):
+        shear_cell_bulk_values(table, R, Z_SHEAR, Z_FLOOR)
