@@ -49,7 +49,7 @@ def test_out_of_range_value_names_key():
 def test_malformed_yaml_names_file(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("design: [unclosed\n")
-    with pytest.raises(ConfigError, match="bad.yaml"):
+    with pytest.raises(ConfigError, match=r"bad\.yaml"):
         load_config(bad)
 
 

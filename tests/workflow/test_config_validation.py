@@ -14,9 +14,20 @@ def _dry_run(tmp_path: Path, config: dict) -> subprocess.CompletedProcess:
     cfg = tmp_path / "cfg.yaml"
     cfg.write_text(yaml.safe_dump(config))
     return subprocess.run(
-        [*SNAKEMAKE, "--cores", "1", "--dry-run", "--configfile", str(cfg),
-         "--directory", str(ROOT)],
-        capture_output=True, text=True, cwd=ROOT, timeout=120,
+        [
+            *SNAKEMAKE,
+            "--cores",
+            "1",
+            "--dry-run",
+            "--configfile",
+            str(cfg),
+            "--directory",
+            str(ROOT),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        timeout=120,
     )
 
 

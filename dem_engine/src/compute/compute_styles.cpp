@@ -1,5 +1,10 @@
-#include "core/compute.h"
+#include "compute/compute_styles.h"
+
+#include <map>
+#include <string>
+
 #include "core/simulation.h"
+#include "deck/errors.h"
 
 namespace dem {
 
@@ -11,14 +16,28 @@ Compute::Compute(Simulation& sim, const Command& command) : sim_(sim) {
   args_.assign(command.args.begin() + 3, command.args.end());
 }
 
-double Compute::scalar() const { throw EngineError("compute " + id_ + " has no scalar"); }
-double Compute::vector(int index) const {
-  throw EngineError("compute " + id_ + " has no vector element " + std::to_string(index));
+double Compute::scalar() const {
+  throw EngineError("compute " + id_ + " (" + style_ + ") has no global scalar");
 }
 
-std::unique_ptr<Compute> make_compute(Simulation&, const Command& command) {
-  throw EngineError("unknown compute style '" + (command.args.size() > 2 ? command.args[2] : "") +
-                    "'");
+double Compute::vector(int index) const {
+  throw EngineError("compute " + id_ + " (" + style_ + ") has no global vector element " +
+                    std::to_string(index));
+}
+
+std::unique_ptr<Compute> make_compute(Simulation& sim, const Command& command) {
+  using Factory = std::unique_ptr<Compute> (*)(Simulation&, const Command&);
+  static const std::map<std::string, Factory> styles = {
+      {"erotate/sphere", make_erotate_sphere},
+      {"contact/atom", make_contact_atom},
+      {"reduce", make_reduce},
+  };
+  const std::string style = command.args.size() > 2 ? command.args[2] : std::string();
+  const auto it = styles.find(style);
+  if (it == styles.end())
+    throw EngineError("unknown compute style '" + style +
+                      "' (supported: erotate/sphere, contact/atom, reduce)");
+  return it->second(sim, command);
 }
 
 }  // namespace dem

@@ -138,7 +138,8 @@ void Simulation::handle_lost_particles() {
 }
 
 void Simulation::check_timestep() {
-  if (atoms.size() == 0 && max_radius() == 0.0) return;
+  if (atoms.size() == 0) return;  // checked again once the first particles are inserted
+  timestep_checked_ = true;
   // Rayleigh time of the smallest particle of each type present (LIGGGHTS check/timestep/gran).
   double t_rayleigh = 1e300;
   double rmin = 1e300, rho_of_rmin = 0.0;
@@ -154,7 +155,6 @@ void Simulation::check_timestep() {
       rho_of_rmin = atoms.density[i];
     }
   }
-  if (atoms.size() == 0) return;
   // Hertz contact time at the largest expected impact speed: particle and wall speeds, and a
   // free fall over the box height.
   double vmax = 0.0;
@@ -182,6 +182,7 @@ void Simulation::setup_run() {
                  pair->spec().cohesion_sjkr);
   for (auto& f : fixes) f->init();
   handle_lost_particles();
+  timestep_checked_ = false;
   check_timestep();
   neighbor.force_rebuild();
   neighbor.build(atoms, domain);
@@ -196,6 +197,7 @@ void Simulation::integrate_step() {
   for (auto& f : fixes) f->initial_integrate();
   for (auto& f : fixes) f->post_integrate();
   for (auto& f : fixes) f->pre_exchange();
+  if (!timestep_checked_) check_timestep();
   if (neighbor.due(atoms, step - last_build_step_)) {
     handle_lost_particles();
     neighbor.build(atoms, domain);

@@ -24,6 +24,7 @@ void Simulation::run_deck(
     const std::vector<std::pair<std::string, std::vector<std::string>>>& command_line_vars) {
   for (const auto& [name, values] : command_line_vars)
     variables.define_from_command_line(name, values);
+  if (options_.echo_screen) input_->run_line("echo screen", SourceLocation{path, 0});
   input_->run_file(path);
 }
 
@@ -158,16 +159,21 @@ double Simulation::group_function(const std::string& fn, const std::vector<std::
                            : (fn == "mass" ? atoms.rmass[i] : 0.5 * atoms.rmass[i] * norm2(atoms.v[i]));
     return s;
   }
-  if (fn == "xcm" || fn == "vcm") {
+  if (fn == "xcm" || fn == "vcm" || fn == "fcm") {
     if (args.size() < 2) throw EngineError(fn + "() needs a group and a dimension");
     const int d = dim_index(args[1]);
     region_arg(2);
     double m = 0.0, s = 0.0;
     for (std::size_t i = 0; i < n; ++i)
       if (selected(i)) {
+        if (fn == "fcm") {
+          s += atoms.f[i][d];  // total force on the group
+          continue;
+        }
         m += atoms.rmass[i];
         s += atoms.rmass[i] * (fn == "xcm" ? atoms.x[i][d] : atoms.v[i][d]);
       }
+    if (fn == "fcm") return s;
     return m > 0.0 ? s / m : 0.0;
   }
   if (fn == "bound") {

@@ -114,7 +114,7 @@ class Simulation : public CommandHandler, public EvalContext {
   std::chrono::steady_clock::time_point wall_start_;
   long last_build_step_ = 0;
   std::vector<std::vector<Vec3>> thread_force_, thread_torque_;
-  bool lost_ignore_ = false;
+  bool timestep_checked_ = false;
 };
 
 }  // namespace dem

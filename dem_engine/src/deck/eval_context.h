@@ -13,7 +13,7 @@ class EvalContext {
   // Thermo keywords usable bare in expressions (step, time, dt, atoms, ke, cpu, ...);
   // std::nullopt when the name is not a thermo keyword.
   virtual std::optional<double> thermo_keyword(const std::string& name) const = 0;
-  // Group functions: count(g), mass(g), xcm(g,dim), vcm(g,dim), bound(g,xmin|xmax|...), ke(g).
+  // Group functions: count(g), mass(g), xcm(g,dim), vcm(g,dim), fcm(g,dim), bound(g,xmin|...), ke(g).
   virtual double group_function(const std::string& function,
                                 const std::vector<std::string>& args) const = 0;
   // c_ID (index 0) or c_ID[i] (index i >= 1); likewise f_ID and f_ID[i].

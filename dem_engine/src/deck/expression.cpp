@@ -1,6 +1,6 @@
 // Equal-style formula evaluation (LAMMPS/LIGGGHTS `variable NAME equal FORMULA`).
 //
-// Precedence, highest first: unary - and !, ^ (right associative), * / %, + -, < <= > >=,
+// Precedence, highest first: unary - and !, ^ (left to right, as LAMMPS), * / %, + -, < <= > >=,
 // == !=, &&, ||. As in LAMMPS, unary minus binds tighter than ^, so -2^2 is 4.
 #include <cerrno>
 #include <cmath>
@@ -58,7 +58,7 @@ bool is_space(char c) {
 
 bool is_group_function(const std::string& name) {
   return name == "count" || name == "mass" || name == "xcm" || name == "vcm" ||
-         name == "bound" || name == "ke";
+         name == "fcm" || name == "bound" || name == "ke";
 }
 
 // Number of arguments of a math function; 0 when `name` is not one.
@@ -223,17 +223,15 @@ class Parser {
     }
   }
   double parse_power() {
-    // a ^ b ^ c is a ^ (b ^ c): collect the operands, then fold from the right.
-    std::vector<double> operands{parse_unary()};
-    while (accept("^")) operands.push_back(parse_unary());
-    double value = operands.back();
-    for (std::size_t i = operands.size() - 1; i-- > 0;) {
-      const double base = operands[i];
-      if (base == 0.0 && value < 0.0) fail("zero raised to a negative power");
-      if (base < 0.0 && value != std::floor(value)) {
+    // LAMMPS evaluates ^ left to right: a ^ b ^ c is (a ^ b) ^ c.
+    double value = parse_unary();
+    while (accept("^")) {
+      const double exponent = parse_unary();
+      if (value == 0.0 && exponent < 0.0) fail("zero raised to a negative power");
+      if (value < 0.0 && exponent != std::floor(exponent)) {
         fail("negative number raised to a non-integer power");
       }
-      value = std::pow(base, value);
+      value = std::pow(value, exponent);
     }
     return value;
   }
@@ -360,6 +358,7 @@ class Parser {
       skip_space();
       const std::string arg = read_identifier();
       skip_space();
+      if (at_end()) fail("missing ')' after " + name + "(");
       if (arg.empty() || (peek() != ',' && peek() != ')')) {
         fail("group function " + name + "() takes a group ID and a keyword, not formulas");
       }
@@ -370,13 +369,15 @@ class Parser {
       }
       ++pos_;
     }
-    const bool two_args = name == "xcm" || name == "vcm" || name == "bound";
-    const std::size_t wanted = two_args ? 2 : 1;
-    if (args.size() != wanted) {
-      fail(name + "() takes " + std::to_string(wanted) + " argument" + (two_args ? "s" : "") +
-           ", got " + std::to_string(args.size()));
+    // count(g), mass(g), ke(g); xcm(g,dim), vcm(g,dim), fcm(g,dim), bound(g,dir); each
+    // optionally with a trailing region ID (LAMMPS region functions).
+    const bool with_keyword = name == "xcm" || name == "vcm" || name == "fcm" || name == "bound";
+    const std::size_t wanted = with_keyword ? 2 : 1;
+    if (args.size() != wanted && args.size() != wanted + 1) {
+      fail(name + "() takes " + std::to_string(wanted) + " or " + std::to_string(wanted + 1) +
+           " arguments, got " + std::to_string(args.size()));
     }
-    if (name == "xcm" || name == "vcm") {
+    if (name == "xcm" || name == "vcm" || name == "fcm") {
       if (args[1] != "x" && args[1] != "y" && args[1] != "z") {
         fail(name + "(): dimension must be x, y or z, not '" + args[1] + "'");
       }
@@ -385,7 +386,9 @@ class Parser {
       static const char* const kDirs[] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
       bool known = false;
       for (const char* dir : kDirs) known = known || args[1] == dir;
-      if (!known) fail("bound(): direction must be xmin|xmax|ymin|ymax|zmin|zmax, not '" + args[1] + "'");
+      if (!known) {
+        fail("bound(): direction must be xmin|xmax|ymin|ymax|zmin|zmax, not '" + args[1] + "'");
+      }
     }
     try {
       return ctx_.group_function(name, args);

@@ -112,7 +112,8 @@ void Variables::define(const std::vector<std::string>& args) {
       bounds.pop_back();
     }
     if (bounds.empty() || bounds.size() > 2) {
-      throw EngineError("loop variable '" + name + "' expects 'loop N [pad]' or 'loop N1 N2 [pad]'");
+      throw EngineError("loop variable '" + name +
+                        "' expects 'loop N [pad]' or 'loop N1 N2 [pad]'");
     }
     long long first = 1;
     long long last = 0;

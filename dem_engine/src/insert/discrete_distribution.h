@@ -18,7 +18,8 @@ struct SphereTemplate {
   double mass() const;         // kg
 };
 
-// Discrete mixture of sphere templates (fix particledistribution/discrete[/massbased|/numberbased]).
+// Discrete mixture of sphere templates
+// (fix particledistribution/discrete[/massbased|/numberbased]).
 // Weights are mass fractions (mass-based) or number fractions (number-based); both are
 // converted to number fractions, which is what a random draw of particles needs.
 class DiscreteDistribution {

@@ -182,6 +182,7 @@ void InsertFix::init() {
       throw EngineError("fix " + id() + ": template " + dist.at(k).id + " has atom type " +
                         std::to_string(dist.at(k).atom_type) + " but the box has only " +
                         std::to_string(sim_.ntypes) + " types");
+  check_region_inside_box();
   if (prepared_) return;
   const Region& r = region();
   const Domain& box = sim_.domain;
@@ -254,10 +255,10 @@ bool InsertFix::sample_position(double radius, Vec3& p) {
   return false;
 }
 
-long InsertFix::insert(long n) {
+long InsertFix::insert(long n, bool exact) {
   const DiscreteDistribution& dist = distribution();
   const auto* pdd = find_distribution(sim_, distribution_id_);
-  const std::vector<std::size_t> order = dist.draw(n, random_, exact_);
+  const std::vector<std::size_t> order = dist.draw(n, random_, exact);
   auto& atoms = sim_.atoms;
   const Domain& box = sim_.domain;
   const double r_new = dist.max_radius();
@@ -300,6 +301,10 @@ long InsertFix::insert(long n) {
     ++next;
   }
   if (inserted > 0) sim_.particles_changed();
+  if (inserted < static_cast<long>(order.size()))
+    sim_.warning("Particle insertion " + id() + ": less insertions than requested (" +
+                 std::to_string(inserted) + " of " + std::to_string(order.size()) + " at step " +
+                 std::to_string(sim_.step) + "; raise maxattempt or lower the target)");
   return inserted;
 }
 
@@ -307,7 +312,7 @@ void InsertFix::pre_exchange() {
   if (next_step_ < 0 || sim_.step != next_step_) return;
   const long n = count_this_event();
   const double mass_before = mass_inserted_;
-  const long inserted = n > 0 ? insert(n) : 0;
+  const long inserted = n > 0 ? insert(n, exact_ || completes_total(n)) : 0;
   ninserted_ += inserted;
   if (verbose_ && n > 0) {
     char text[256];
@@ -318,10 +323,6 @@ void InsertFix::pre_exchange() {
                   mass_inserted_);
     sim_.message(text);
   }
-  if (inserted < n)
-    sim_.warning("Particle insertion " + id() + ": less insertions than requested (" +
-                 std::to_string(inserted) + " of " + std::to_string(n) + " at step " +
-                 std::to_string(sim_.step) + "; raise maxattempt or lower the target)");
   next_step_ = insert_every_ > 0 && !finished() ? next_step_ + insert_every_ : -1;
 }
 

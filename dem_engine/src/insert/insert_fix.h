@@ -34,6 +34,9 @@ class InsertFix : public Fix {
   virtual long count_this_event() = 0;
   // True when no further insertion events are due after the one at `step`.
   virtual bool finished() const = 0;
+  // True when inserting n particles completes a fixed total; the split among templates is then
+  // exact even with random_distribute uncorrelated, so the total is not overshot.
+  virtual bool completes_total(long /*n*/) const { return false; }
 
   const DiscreteDistribution& distribution() const;
   Region& region() const;
@@ -43,8 +46,9 @@ class InsertFix : public Fix {
   // True when the particle at local index i counts as inside the region (centre, or the whole
   // sphere with all_in yes).
   bool counts_in_region(std::size_t i) const;
-  // Inserts up to n particles; returns the number inserted.
-  long insert(long n);
+  // Inserts up to n particles (split among templates exactly or independently); returns the
+  // number inserted.
+  long insert(long n, bool exact);
 
   RandomStream random_;
   long insert_every_ = -1;  // -1 unset, 0 once
@@ -99,6 +103,7 @@ class InsertRateRegionFix : public InsertFix {
   void prepare() override;
   long count_this_event() override;
   bool finished() const override { return total_ >= 0 && ninserted_ >= total_; }
+  bool completes_total(long n) const override { return total_ >= 0 && ninserted_ + n >= total_; }
 
  private:
   long total_ = -2;  // -2 unset, -1 INF

@@ -36,6 +36,7 @@ ParticleTemplateFix::ParticleTemplateFix(Simulation& sim, const Command& command
   sphere_.id = id();
   sphere_.group_bit = group_bit();
   double volume_limit = 1e-12;
+  bool has_radius = false, has_density = false;
   std::size_t i = 1;
   while (i < a.size()) {
     const std::string& key = a[i];
@@ -46,9 +47,11 @@ ParticleTemplateFix::ParticleTemplateFix(Simulation& sim, const Command& command
       i += 2;
     } else if (key == "radius") {
       sphere_.radius = constant_value(a, i, "radius");
+      has_radius = true;
       if (!(sphere_.radius > 0.0)) throw EngineError("radius must be > 0");
     } else if (key == "density") {
       sphere_.density = constant_value(a, i, "density");
+      has_density = true;
       if (!(sphere_.density > 0.0)) throw EngineError("density must be > 0");
     } else if (key == "volume_limit") {
       if (i + 1 >= a.size()) throw EngineError("'volume_limit' needs a value");
@@ -64,6 +67,9 @@ ParticleTemplateFix::ParticleTemplateFix(Simulation& sim, const Command& command
       throw EngineError("unknown particletemplate/sphere keyword '" + key + "'");
     }
   }
+  // LIGGGHTS requires both, despite the defaults its documentation lists.
+  if (!has_density) throw EngineError("have to define 'density'");
+  if (!has_radius) throw EngineError("have to define 'radius'");
   if (sphere_.volume() < volume_limit) {
     std::ostringstream os;
     os << "particle volume " << sphere_.volume() << " m^3 is below volume_limit " << volume_limit

@@ -6,8 +6,8 @@
 
 namespace dem {
 
-// `fix ID group particletemplate/sphere SEED [atom_type T] [density constant RHO]
-//  [radius constant R] [volume_limit V] [relative no]`: one kind of sphere to insert.
+// `fix ID group particletemplate/sphere SEED [atom_type T] density constant RHO
+//  radius constant R [volume_limit V] [relative no]`: one kind of sphere to insert.
 class ParticleTemplateFix : public Fix {
  public:
   ParticleTemplateFix(Simulation& sim, const Command& command);

@@ -74,7 +74,8 @@ void remove_redundant_contacts(std::vector<MeshContact>& contacts,
 }
 
 int assign_history_slots(double* slots, const std::vector<MeshContact>& contacts,
-                         double cos_curvature, std::vector<double*>& history, double* overflow) {
+                         const std::vector<double>& cos_curvature, std::vector<double*>& history,
+                         double* overflow) {
   const std::size_t n = contacts.size();
   history.assign(n, nullptr);
   bool used[kMeshSlots] = {};
@@ -96,7 +97,7 @@ int assign_history_slots(double* slots, const std::vector<MeshContact>& contacts
     if (history[c]) continue;
     const MeshContact& mc = contacts[c];
     int best = -1;
-    double best_cos = cos_curvature;
+    double best_cos = cos_curvature[mc.mesh];
     for (int s = 0; s < kMeshSlots; ++s) {
       const double* sl = slot(s);
       if (used[s] || sl[0] == 0.0 || mesh_of_key(sl[0]) != mc.mesh) continue;

@@ -41,11 +41,13 @@ constexpr int kMeshSlotWidth = 4 + kHistorySize;
 // Assigns a history (kHistorySize doubles) to every contact of one particle: the slot of the
 // same triangle if it was touching at the previous step; otherwise the slot of a triangle of
 // the same mesh that stopped touching now and whose contact normal is within the curvature
-// angle (`cos_curvature`), so the tangential spring survives crossing a flat or gently bent
+// angle of that mesh, so the tangential spring survives crossing a flat or gently bent
 // edge; otherwise a fresh zero history. Slots of contacts that opened are cleared. Contacts
 // beyond kMeshSlots get a zero history in `overflow` (kHistorySize doubles each) that is not
 // kept; returns the number of such contacts.
+// `cos_curvature` is indexed by mesh.
 int assign_history_slots(double* slots, const std::vector<MeshContact>& contacts,
-                         double cos_curvature, std::vector<double*>& history, double* overflow);
+                         const std::vector<double>& cos_curvature, std::vector<double*>& history,
+                         double* overflow);
 
 }  // namespace dem

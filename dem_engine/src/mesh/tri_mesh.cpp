@@ -1,6 +1,8 @@
 #include "mesh/tri_mesh.h"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <cmath>
 
 #include "deck/errors.h"
@@ -20,6 +22,37 @@ TriMesh::TriMesh(const std::vector<Triangle>& triangles, const std::string& sour
     for (const Vec3& p : v) nodes_.push_back(p);
   }
   velocities_.assign(nodes_.size(), Vec3{});
+  reject_duplicates(source);
+}
+
+void TriMesh::reject_duplicates(const std::string& source) const {
+  // Two copies of a facet would double the wall force. Facets are compared by their vertices
+  // in sorted order, so the vertex order and orientation do not matter.
+  using Key = std::array<double, 9>;
+  const std::size_t n = size();
+  std::vector<std::pair<Key, std::size_t>> keys(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    std::array<Vec3, 3> v{node(t, 0), node(t, 1), node(t, 2)};
+    std::sort(v.begin(), v.end(), [](const Vec3& a, const Vec3& b) {
+      return a.x != b.x ? a.x < b.x : (a.y != b.y ? a.y < b.y : a.z < b.z);
+    });
+    for (int k = 0; k < 3; ++k)
+      for (int d = 0; d < 3; ++d) keys[t].first[3 * k + d] = v[k][d];
+    keys[t].second = t;
+  }
+  std::sort(keys.begin(), keys.end());
+  // Nodes closer than this are the same node (LIGGGHTS' default mesh precision).
+  constexpr double kPrecision = 1e-8;
+  for (std::size_t k = 1; k < n; ++k) {
+    bool same = true;
+    for (int d = 0; d < 9 && same; ++d)
+      same = std::fabs(keys[k].first[d] - keys[k - 1].first[d]) <= kPrecision;
+    if (same) {
+      const auto [a, b] = std::minmax(keys[k - 1].second, keys[k].second);
+      throw EngineError("mesh from " + source + ": triangles " + std::to_string(a + 1) + " and " +
+                        std::to_string(b + 1) + " are duplicates");
+    }
+  }
 }
 
 std::vector<Triangle> TriMesh::triangles() const {

@@ -65,6 +65,8 @@ class TriMesh {
   std::vector<Frame> frames_;
   long version_ = 0;
   bool moving_ = false;
+
+  void reject_duplicates(const std::string& source) const;
 };
 
 }  // namespace dem

@@ -1,6 +1,10 @@
-#include "core/simulation.h"
+#include <memory>
+
 #include "core/numbers.h"
+#include "core/simulation.h"
+#include "deck/errors.h"
 #include "io/dump.h"
+#include "output/atom_dump.h"
 
 namespace dem {
 
@@ -15,10 +19,28 @@ Dump::Dump(Simulation& sim, const Command& command) : sim_(sim) {
 }
 
 void Dump::modify(const std::vector<std::string>& args) {
-  throw EngineError("dump_modify: unsupported keyword '" + (args.empty() ? "" : args[0]) + "'");
+  for (std::size_t i = 0; i < args.size(); i += 2) {
+    const std::string& key = args[i];
+    if (key != "every")
+      throw EngineError("dump_modify: keyword '" + key + "' is not supported for dump " + id_ +
+                        " (" + style_ + ")");
+    if (i + 1 >= args.size()) throw EngineError("dump_modify every needs N");
+    if (args[i + 1].rfind("v_", 0) == 0)
+      throw EngineError("dump_modify every v_name is not supported (give a number of steps)");
+    const long n = parse_int(args[i + 1], "dump_modify every");
+    if (n < 1) throw EngineError("dump_modify every N must be >= 1");
+    every_ = n;
+  }
 }
 
-void register_dump_styles(DumpRegistry&) {}
+void register_dump_styles(DumpRegistry& registry) {
+  registry["custom"] = [](Simulation& sim, const Command& c) {
+    return std::make_unique<DumpCustom>(sim, c);
+  };
+  registry["custom/vtk"] = [](Simulation& sim, const Command& c) {
+    return std::make_unique<DumpCustomVtk>(sim, c);
+  };
+}
 
 const DumpRegistry& dump_registry() {
   static const DumpRegistry registry = [] {

@@ -204,7 +204,8 @@ void FixAveTime::end_of_step() {
 void FixAveTime::write_output() {
   if (path_.empty()) return;
   std::string row = format_integer(sim_.step);
-  for (std::size_t k = 0; k < inputs_.size(); ++k) row += " " + format_number("%g", average_->value(k));
+  for (std::size_t k = 0; k < inputs_.size(); ++k)
+    row += " " + format_number("%g", average_->value(k));
   row += '\n';
   if (overwrite_) {
     // Only the latest output is kept; the file is replaced whole so it is never seen half-written.

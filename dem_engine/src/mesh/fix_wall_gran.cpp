@@ -1,0 +1,278 @@
+#include "mesh/fix_wall_gran.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "core/numbers.h"
+#include "core/simulation.h"
+#include "deck/errors.h"
+
+namespace dem {
+
+namespace {
+
+bool same_spec(const ModelSpec& a, const ModelSpec& b) {
+  return a.cohesion_sjkr == b.cohesion_sjkr && a.rolling_epsd2 == b.rolling_epsd2 &&
+         a.options.limit_force == b.options.limit_force &&
+         a.options.tangential_damping == b.options.tangential_damping;
+}
+
+std::string describe(const ModelSpec& s) {
+  std::string text = "model hertz tangential history";
+  if (s.cohesion_sjkr) text += " cohesion sjkr";
+  if (s.rolling_epsd2) text += " rolling_friction epsd2";
+  if (s.options.limit_force) text += " limitForce on";
+  if (!s.options.tangential_damping) text += " tangential_damping off";
+  return text;
+}
+
+// Largest overlap (fraction of the radius) a wall contact may reach before the run is declared
+// unstable, as for particle pairs.
+constexpr double kMaxOverlapRatio = 0.5;
+// Contacts of one particle that are evaluated (beyond any plausible packing).
+constexpr std::size_t kMaxContacts = 64;
+// Below this many particles a parallel region costs more than it saves.
+constexpr std::size_t kParallelMin = 4096;
+
+}  // namespace
+
+FixWallGran::FixWallGran(Simulation& sim, const Command& command) : Fix(sim, command) {
+  const auto& a = args();
+  std::size_t p = parse_model_spec(a, 0, spec_, true);
+  check_model();
+  if (p >= a.size()) throw EngineError("expected 'primitive' or 'mesh' after the model");
+  if (a[p] == "primitive") {
+    ++p;
+    if (p + 1 >= a.size() || a[p] != "type")
+      throw EngineError("expected 'type T' after 'primitive'");
+    const long t = parse_int(a[p + 1], "wall type");
+    if (t < 1 || t > sim.ntypes)
+      throw EngineError("wall type " + a[p + 1] + " must be between 1 and the " +
+                        std::to_string(sim.ntypes) + " atom types of create_box");
+    wall_type_ = static_cast<int>(t);
+    p += 2;
+    wall_ = PrimitiveWall::parse(a, p);
+    history_ = sim.atoms.register_extra("wall/gran:" + id() + ":primitive", kHistorySize);
+  } else if (a[p] == "mesh") {
+    mesh_mode_ = true;
+    ++p;
+    if (p + 1 >= a.size() || a[p] != "n_meshes")
+      throw EngineError("expected 'n_meshes N' after 'mesh'");
+    const long n = parse_int(a[p + 1], "n_meshes");
+    if (n < 1) throw EngineError("n_meshes must be >= 1");
+    p += 2;
+    if (p >= a.size() || a[p] != "meshes") throw EngineError("expected 'meshes ID1 ...'");
+    ++p;
+    if (p + static_cast<std::size_t>(n) > a.size())
+      throw EngineError("'meshes' lists fewer than n_meshes = " + std::to_string(n) + " IDs");
+    for (long k = 0; k < n; ++k, ++p) {
+      const std::string& mid = a[p];
+      if (std::find(mesh_ids_.begin(), mesh_ids_.end(), mid) != mesh_ids_.end())
+        throw EngineError("mesh '" + mid + "' is listed twice");
+      Fix* f = sim.find_fix(mid);
+      if (!f) throw EngineError("unknown mesh fix '" + mid + "' (define it before the wall)");
+      if (!dynamic_cast<FixMeshSurface*>(f))
+        throw EngineError("fix '" + mid + "' is not a fix mesh/surface");
+      mesh_ids_.push_back(mid);
+    }
+    history_ =
+        sim.atoms.register_extra("wall/gran:" + id() + ":mesh", kMeshSlots * kMeshSlotWidth);
+  } else {
+    throw EngineError("expected 'primitive' or 'mesh', got '" + a[p] + "'");
+  }
+  if (p < a.size())
+    throw EngineError("unexpected '" + a[p] +
+                      "' after the wall definition (model keywords go before 'primitive' or "
+                      "'mesh'; wall keywords such as shear or store_force are not supported by "
+                      "this engine)");
+}
+
+void FixWallGran::check_model() const {
+  const ContactModel& pair = sim_.pair_model();
+  if (!same_spec(pair.spec(), spec_))
+    throw EngineError("the wall model '" + describe(spec_) +
+                      "' differs from the pair style's '" + describe(pair.spec()) + "'");
+}
+
+void FixWallGran::init() {
+  check_model();
+  if (!mesh_mode_) {
+    if (wall_.kind == PrimitiveWall::Kind::kPlane && sim_.domain.periodic(wall_.dim))
+      throw EngineError(std::string("a ") + static_cast<char>('x' + wall_.dim) +
+                        "plane wall needs a non-periodic boundary in that dimension");
+    return;
+  }
+  mesh_fixes_.clear();
+  meshes_.clear();
+  for (const std::string& mid : mesh_ids_) {
+    Fix* f = sim_.find_fix(mid);
+    auto* mf = f ? dynamic_cast<FixMeshSurface*>(f) : nullptr;
+    if (!mf) throw EngineError("mesh fix '" + mid + "' used by fix " + id() + " no longer exists");
+    mf->mark_used_by_wall();
+    mesh_fixes_.push_back(mf);
+    meshes_.push_back(&mf->mesh());
+  }
+  list_.force_rebuild();
+  stress_bits_.assign(meshes_.size(), 0);
+  reference_.assign(meshes_.size(), Vec3{});
+  cos_curvature_.clear();
+  for (const FixMeshSurface* mf : mesh_fixes_) cos_curvature_.push_back(mf->cos_curvature());
+  const int nthreads = std::max(1, omp_get_max_threads());
+  scratch_.resize(nthreads);
+  for (Scratch& s : scratch_) {
+    s.contacts.reserve(16);
+    s.history.reserve(16);
+    s.overflow.assign(kMaxContacts * kHistorySize, 0.0);
+    s.force.assign(meshes_.size(), Vec3{});
+    s.torque.assign(meshes_.size(), Vec3{});
+  }
+}
+
+void FixWallGran::post_force() {
+  if (mesh_mode_) mesh_forces();
+  else primitive_forces();
+}
+
+void FixWallGran::primitive_forces() {
+  Particles& P = sim_.atoms;
+  const std::size_t n = P.size();
+  const std::uint32_t bit = group_bit();
+  double* hist_all = P.extra(history_).data();
+  double worst = 0.0;
+  long worst_tag = -1;
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    double my_worst = 0.0;
+    long my_tag = -1;
+#pragma omp for schedule(static, 64)
+    for (std::size_t i = 0; i < n; ++i) {
+      double* hist = hist_all + i * kHistorySize;
+      Vec3 normal;
+      double dist = 0.0;
+      if (!(P.mask[i] & bit) || !wall_.contact(P.x[i], P.radius[i], normal, dist)) {
+        std::fill(hist, hist + kHistorySize, 0.0);
+        continue;
+      }
+      const double overlap = P.radius[i] - dist;
+      ContactResult res;
+      sim_.wall_contact(i, normal, overlap, dist, Vec3{}, wall_type_, hist, res);
+      P.f[i] += res.force;
+      P.torque[i] += res.torque_i;
+      if (overlap > my_worst * P.radius[i]) {
+        my_worst = overlap / P.radius[i];
+        my_tag = static_cast<long>(P.tag[i]);
+      }
+    }
+#pragma omp critical
+    if (my_worst > worst || (my_worst == worst && my_tag >= 0 && my_tag < worst_tag)) {
+      worst = my_worst;
+      worst_tag = my_tag;
+    }
+  }
+  finish_step(worst, worst_tag, 0);
+}
+
+void FixWallGran::mesh_forces() {
+  Particles& P = sim_.atoms;
+  const std::size_t n = P.size();
+  const std::uint32_t bit = group_bit();
+  if (list_.due(P, meshes_)) list_.build(P, bit, meshes_, sim_.neighbor.skin);
+  const std::size_t nm = meshes_.size();
+  std::vector<std::uint32_t>& stress_bits = stress_bits_;
+  std::vector<Vec3>& ref = reference_;
+  for (std::size_t m = 0; m < nm; ++m) {
+    stress_bits[m] = mesh_fixes_[m]->tracks_stress() ? mesh_fixes_[m]->group_bit() : 0;
+    ref[m] = mesh_fixes_[m]->reference_point();
+  }
+  double* slots_all = P.extra(history_).data();
+  const int* first = list_.first.data();
+  const TriRef* refs = list_.refs.data();
+  double worst = 0.0;
+  long worst_tag = -1, overflow = 0;
+  const int nthreads = static_cast<int>(scratch_.size());
+  // Cleared here, not in the parallel region: with few particles only thread 0 runs it.
+  for (Scratch& s : scratch_) {
+    std::fill(s.force.begin(), s.force.end(), Vec3{});
+    std::fill(s.torque.begin(), s.torque.end(), Vec3{});
+  }
+#pragma omp parallel num_threads(nthreads) if (n >= kParallelMin) reduction(+ : overflow)
+  {
+    Scratch& s = scratch_[omp_get_thread_num()];
+    double my_worst = 0.0;
+    long my_tag = -1;
+#pragma omp for schedule(static, 64)
+    for (std::size_t i = 0; i < n; ++i) {
+      double* slots = slots_all + i * kMeshSlots * kMeshSlotWidth;
+      s.contacts.clear();
+      if (P.mask[i] & bit)
+        find_mesh_contacts(P.x[i], P.radius[i], refs + first[i], first[i + 1] - first[i], meshes_,
+                           s.contacts);
+      if (s.contacts.empty()) {
+        // Release the slots of contacts that opened.
+        for (int k = 0; k < kMeshSlots; ++k)
+          if (slots[k * kMeshSlotWidth] != 0.0)
+            std::fill(slots + k * kMeshSlotWidth, slots + (k + 1) * kMeshSlotWidth, 0.0);
+        continue;
+      }
+      if (s.contacts.size() > kMaxContacts) s.contacts.resize(kMaxContacts);
+      overflow += assign_history_slots(slots, s.contacts, cos_curvature_, s.history,
+                                       s.overflow.data());
+      for (std::size_t k = 0; k < s.contacts.size(); ++k) {
+        const MeshContact& c = s.contacts[k];
+        const TriMesh& mesh = *meshes_[c.mesh];
+        const Vec3 v_wall = mesh.moving() ? mesh.velocity_at(c.tri, c.cp) : Vec3{};
+        const double overlap = P.radius[i] - c.dist;
+        ContactResult res;
+        sim_.wall_contact(i, c.normal, overlap, c.dist, v_wall, mesh_fixes_[c.mesh]->wall_type(),
+                          s.history[k], res);
+        P.f[i] += res.force;
+        P.torque[i] += res.torque_i;
+        if (P.mask[i] & stress_bits[c.mesh]) {
+          s.force[c.mesh] -= res.force;
+          s.torque[c.mesh] -= cross(c.cp.point - ref[c.mesh], res.force);
+        }
+        if (overlap > my_worst * P.radius[i]) {
+          my_worst = overlap / P.radius[i];
+          my_tag = static_cast<long>(P.tag[i]);
+        }
+      }
+    }
+#pragma omp critical
+    if (my_worst > worst || (my_worst == worst && my_tag >= 0 && my_tag < worst_tag)) {
+      worst = my_worst;
+      worst_tag = my_tag;
+    }
+  }
+  // Fixed-order reduction of the loads on the meshes.
+  for (std::size_t m = 0; m < nm; ++m) {
+    if (!stress_bits[m]) continue;
+    Vec3 f, t;
+    for (const Scratch& s : scratch_) {
+      f += s.force[m];
+      t += s.torque[m];
+    }
+    mesh_fixes_[m]->add_wall_load(f, t);
+  }
+  finish_step(worst, worst_tag, overflow);
+}
+
+void FixWallGran::finish_step(double worst_ratio, long worst_tag, long overflow) {
+  if (worst_ratio > kMaxOverlapRatio) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.3g", 100.0 * worst_ratio);
+    throw EngineError("unstable simulation at step " + std::to_string(sim_.step) + ": particle " +
+                      std::to_string(worst_tag) + " overlaps wall " + id() + " by " + buf +
+                      " % of its radius (time step too large, particles too soft or wall too fast)");
+  }
+  if (overflow > 0 && !overflow_warned_) {
+    overflow_warned_ = true;
+    sim_.warning("fix " + id() + ": a particle touches more than " + std::to_string(kMeshSlots) +
+                 " mesh triangles at step " + std::to_string(sim_.step) +
+                 "; the extra contacts get no tangential history");
+  }
+}
+
+}  // namespace dem

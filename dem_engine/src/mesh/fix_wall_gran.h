@@ -1,0 +1,63 @@
+#pragma once
+#include <string>
+#include <vector>
+
+#include "contact/contact_model.h"
+#include "fix/fix.h"
+#include "mesh/fix_mesh_surface.h"
+#include "mesh/mesh_contacts.h"
+#include "mesh/primitive_wall.h"
+#include "mesh/tri_neighbor_list.h"
+
+namespace dem {
+
+// fix ID group wall/gran model hertz tangential history [cohesion sjkr] [rolling_friction epsd2]
+//     [model keywords] primitive type T xplane|yplane|zplane C
+// fix ID group wall/gran ... primitive type T xcylinder|ycylinder|zcylinder R C1 C2
+// fix ID group wall/gran ... mesh n_meshes N meshes ID1 ... IDN
+// Granular walls with the contact law of pair_style gran (the model words must match it).
+// Particles of the group interact with the wall from the side their centre is on; forces and
+// torques are added in post_force. One contact history per particle and contact (primitive:
+// one; mesh: up to kMeshSlots, see assign_history_slots) lives in per-particle storage and is
+// cleared when the contact opens. Mesh candidates come from a TriangleNeighborList rebuilt
+// when particles or meshes moved more than skin/2.
+class FixWallGran : public Fix {
+ public:
+  FixWallGran(Simulation& sim, const Command& command);
+  void init() override;
+  void post_force() override;
+
+  const TriangleNeighborList& triangle_list() const { return list_; }
+
+ private:
+  void check_model() const;
+  void primitive_forces();
+  void mesh_forces();
+  void finish_step(double worst_ratio, long worst_tag, long overflow);
+
+  ModelSpec spec_;
+  bool mesh_mode_ = false;
+  // primitive
+  PrimitiveWall wall_;
+  int wall_type_ = 0;
+  // mesh
+  std::vector<std::string> mesh_ids_;
+  std::vector<FixMeshSurface*> mesh_fixes_;  // refreshed at every init
+  std::vector<const TriMesh*> meshes_;
+  TriangleNeighborList list_;
+  std::vector<std::uint32_t> stress_bits_;  // per mesh: group bit if it tracks stress, else 0
+  std::vector<Vec3> reference_;             // per mesh: torque reference point
+  std::vector<double> cos_curvature_;       // per mesh
+  std::size_t history_ = 0;                 // Particles extra handle
+  bool overflow_warned_ = false;
+
+  struct Scratch {
+    std::vector<MeshContact> contacts;
+    std::vector<double*> history;
+    std::vector<double> overflow;
+    std::vector<Vec3> force, torque;  // per mesh: load on the mesh
+  };
+  std::vector<Scratch> scratch_;  // per thread
+};
+
+}  // namespace dem
