@@ -142,7 +142,9 @@ std::unique_ptr<dem::Simulation> make_simulation() {
   return sim;
 }
 
-void deck(dem::Simulation& sim, const std::string& line) { sim.input().run_line(line, {"test", 1}); }
+void deck(dem::Simulation& sim, const std::string& line) {
+  sim.input().run_line(line, {"test", 1});
+}
 
 bool same_vec(const Vec3& a, const Vec3& b, double tol) { return norm(a - b) <= tol; }
 
@@ -578,7 +580,8 @@ TEST_CASE("mesh: mesh/surface applies scale, move and rotate in the order given"
   auto sim = make_simulation();
   deck(*sim, "fix a all mesh/surface file " + stl + " type 2 scale 2 move 1 0 0");
   deck(*sim, "fix b all mesh/surface file " + stl + " type 1 move 1 0 0 scale 2");
-  deck(*sim, "fix c all mesh/surface file " + stl + " type 1 rotate axis 0 0 1 angle 90 move 0 0 1");
+  deck(*sim,
+       "fix c all mesh/surface file " + stl + " type 1 rotate axis 0 0 1 angle 90 move 0 0 1");
   deck(*sim, "fix d all mesh/surface/stress file " + stl +
                  " type 1 curvature 10 stress on reference_point 0 0 1");
   auto& a = dynamic_cast<dem::FixMeshSurface&>(sim->fix("a"));
@@ -593,16 +596,16 @@ TEST_CASE("mesh: mesh/surface applies scale, move and rotate in the order given"
   CHECK_EQ(a.wall_type(), 2);
   CHECK_NEAR(sim->fix("d").vector(1), 0.0, 0.0);
   // Errors name the problem.
-  std::string msg = error_text([&] { deck(*sim, "fix e all mesh/surface file " + stl + " type 3"); });
+  const std::string head = "fix e all mesh/surface file ";
+  std::string msg = error_text([&] { deck(*sim, head + stl + " type 3"); });
   CHECK(contains(msg, "type 3"));
-  msg = error_text([&] { deck(*sim, "fix e all mesh/surface file " + stl + " scale 2 type 1"); });
+  msg = error_text([&] { deck(*sim, head + stl + " scale 2 type 1"); });
   CHECK(contains(msg, "type"));
-  msg = error_text(
-      [&] { deck(*sim, "fix e all mesh/surface file " + stl + " type 1 scale 2 curvature 5 move 1 0 0"); });
+  msg = error_text([&] { deck(*sim, head + stl + " type 1 scale 2 curvature 5 move 1 0 0"); });
   CHECK(contains(msg, "wrong keyword order: move"));
-  msg = error_text([&] { deck(*sim, "fix e all mesh/surface file " + stl + " type 1 heal no"); });
+  msg = error_text([&] { deck(*sim, head + stl + " type 1 heal no"); });
   CHECK(contains(msg, "heal"));
-  msg = error_text([&] { deck(*sim, "fix e all mesh/surface file " + dir.file("none.stl") + " type 1"); });
+  msg = error_text([&] { deck(*sim, head + dir.file("none.stl") + " type 1"); });
   CHECK(contains(msg, "none.stl"));
   msg = error_text([&] {
     deck(*sim, "fix s all mesh/surface/stress/servo file " + stl +

@@ -82,7 +82,8 @@ def preamble(
 @pytest.mark.parametrize("side", [1, -1], ids=["above", "below"])
 def test_sphere_rests_on_plane_at_hertz_static_overlap(tmp_path, wall, side):
     r, rho, plane = 0.005, 2500.0, 0.01
-    x0, y0 = 0.003, -0.002
+    # On the mesh, right above the edge that the plate's two triangles share: one contact.
+    x0, y0 = (0.003, 0.003) if wall == "mesh" else (0.003, -0.002)
     if wall == "primitive":
         wall_lines = f"fix wall all wall/gran {MODEL} primitive type 1 zplane {plane!r}\n"
     else:
@@ -194,6 +195,37 @@ def test_stress_mesh_reports_weight_and_torque_of_resting_spheres(tmp_path):
     np.testing.assert_allclose(got, torque, rtol=0.01, atol=1e-4 * weight * 0.01)
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_stress_mesh_sums_a_layer_of_resting_spheres(tmp_path, threads):
+    # 4900 spheres (enough for the parallel loop) resting at the Hertz overlap on a plate.
+    r, rho, n_side, spacing = 0.001, 2500.0, 70, 0.0025
+    write_stl(tmp_path / "plate.stl", square_plate(0.1))
+    z0 = r - hertz_static_overlap(sphere_mass(r, rho) * G, r)
+    offset = -0.5 * spacing * (n_side - 1)
+    coords = [offset + k * spacing for k in range(n_side)]
+    atoms = "".join(
+        f"create_atoms 1 single {x!r} {y!r} {z0!r} units box\n" for y in coords for x in coords
+    )
+    deck = (
+        header(half_width=0.15)
+        + material_block(YOUNGS, POISSON, 0.5, 0.5)
+        + f"pair_style gran {MODEL}\npair_coeff * *\ntimestep 1e-5\n"
+        + f"fix gravi all gravity {G} vector 0 0 -1\n"
+        + "fix plate all mesh/surface/stress file plate.stl type 1\n"
+        + f"fix wall all wall/gran {MODEL} mesh n_meshes 1 meshes plate\n"
+        + atoms
+        + f"set group all diameter {2 * r!r} density {rho!r}\n"
+        + "fix integr all nve/sphere\n"
+        + "thermo_style custom step f_plate[3] f_plate[4] f_plate[5]\nthermo 100\nrun 200\n"
+    )
+    last = run_engine(tmp_path, deck, threads=threads).thermo()[0].iloc[-1]
+    weight = n_side**2 * sphere_mass(r, rho) * G
+    assert last["f_plate[3]"] == pytest.approx(-weight, rel=1e-3)
+    # The layer is centred on the reference point (the origin): no net torque.
+    assert abs(last["f_plate[4]"]) < 1e-9 * weight
+    assert abs(last["f_plate[5]"]) < 1e-9 * weight
+
+
 # --- servo lid -----------------------------------------------------------------------------
 
 
@@ -243,7 +275,8 @@ def test_servo_lid_reaches_and_holds_target_force(tmp_path):
         + f"fix wlid all wall/gran {MODEL} mesh n_meshes 1 meshes lid\n"
         + "thermo_style custom step f_lid[3] f_lid[7] f_lid[8] f_lid[9]\nthermo 200\n"
         + "run 20000\n"
-        + "fix_modify lid target_val -1.0\n"
+        + "variable target equal -2*0.5\n"
+        + "fix_modify lid target_val v_target\n"
         + "run 20000\n"
         + "fix_modify lid integrate stop\n"
         + "run 2000\n"

@@ -127,7 +127,10 @@ class ComposedModel final : public ContactModel {
           const double radsum = rad[i] + rad[j];
           double* hist = hist_all + static_cast<std::size_t>(k) * kHistorySize;
           if (r2 >= radsum * radsum) {
-            for (int h = 0; h < kHistorySize; ++h) hist[h] = 0.0;
+            // Most listed pairs are apart and already cleared: read before writing.
+            if (hist[0] != 0.0 || hist[1] != 0.0 || hist[2] != 0.0 || hist[3] != 0.0 ||
+                hist[4] != 0.0 || hist[5] != 0.0)
+              for (int h = 0; h < kHistorySize; ++h) hist[h] = 0.0;
             continue;
           }
           ++contacts;

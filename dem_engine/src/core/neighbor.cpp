@@ -35,25 +35,61 @@ std::uint64_t pair_key(std::int64_t a, std::int64_t b, bool& swapped) {
 
 }  // namespace
 
-void NeighborList::build(const Particles& p, const Domain& domain) {
-  // Collect the contacts with history from the previous list, keyed by tags.
-  std::vector<OldContact> old;
-  for (std::size_t i = 0; i + 1 < first.size(); ++i) {
-    for (int k = first[i]; k < first[i + 1]; ++k) {
-      const double* h = &history[static_cast<std::size_t>(k) * kHistorySize];
-      bool any = false;
-      for (int c = 0; c < kHistorySize; ++c) any = any || h[c] != 0.0;
-      if (!any) continue;
-      OldContact oc;
-      oc.key = pair_key(tags_at_build_[i], tags_at_build_[partner[k]], oc.swapped);
-      std::copy(h, h + kHistorySize, oc.hist.begin());
-      old.push_back(oc);
-    }
-  }
-  std::sort(old.begin(), old.end(),
-            [](const OldContact& a, const OldContact& b) { return a.key < b.key; });
-
+std::vector<std::size_t> spatial_order(const Particles& p, double cell) {
   const std::size_t n = p.size();
+  std::vector<std::size_t> order(n);
+  if (n == 0) return order;
+  Vec3 lo = p.x[0], hi = p.x[0];
+  for (const Vec3& x : p.x)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], x[k]);
+      hi[k] = std::max(hi[k], x[k]);
+    }
+  std::array<long, 3> nb{};
+  for (int k = 0; k < 3; ++k) nb[k] = std::clamp(static_cast<long>((hi[k] - lo[k]) / cell) + 1, 1L, 1024L);
+  std::vector<long> key(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    long c[3];
+    for (int k = 0; k < 3; ++k)
+      c[k] = std::clamp(static_cast<long>((p.x[i][k] - lo[k]) / cell), 0L, nb[k] - 1);
+    key[i] = (c[2] * nb[1] + c[1]) * nb[0] + c[0];
+  }
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
+  return order;
+}
+
+void NeighborList::build(const Particles& p, const Domain& domain) {
+  const std::size_t n = p.size();
+  // Contact history transfer: when the particle order is unchanged since the last build, the
+  // old and new partner lists of each particle are both sorted, so a linear merge matches them;
+  // otherwise contacts are matched through their tags.
+  const bool same_order = tags_at_build_ == p.tag;
+  std::vector<OldContact> old;
+  std::vector<int> old_first, old_partner;
+  std::vector<double> old_history;
+  if (same_order) {
+    old_first.swap(first);
+    old_partner.swap(partner);
+    old_history.swap(history);
+  } else {
+    for (std::size_t i = 0; i + 1 < first.size(); ++i) {
+      for (int k = first[i]; k < first[i + 1]; ++k) {
+        const double* h = &history[static_cast<std::size_t>(k) * kHistorySize];
+        bool any = false;
+        for (int c = 0; c < kHistorySize; ++c) any = any || h[c] != 0.0;
+        if (!any) continue;
+        OldContact oc;
+        oc.key = pair_key(tags_at_build_[i], tags_at_build_[partner[k]], oc.swapped);
+        std::copy(h, h + kHistorySize, oc.hist.begin());
+        old.push_back(oc);
+      }
+    }
+    std::sort(old.begin(), old.end(),
+              [](const OldContact& a, const OldContact& b) { return a.key < b.key; });
+  }
+
   first.assign(n + 1, 0);
   partner.clear();
   history.clear();
@@ -105,11 +141,14 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   }
 
   const bool any_periodic = domain.periodic(0) || domain.periodic(1) || domain.periodic(2);
+  // Partners are found bin by bin (one stencil per bin) and then stored per particle.
+  std::vector<std::vector<int>> found(n);
   std::vector<int> stencil;
   stencil.reserve(27);
-  for (std::size_t i = 0; i < n; ++i) {
-    const int b = bin_of[i];
-    const int bx = b % nb[0], by = (b / nb[0]) % nb[1], bz = b / (nb[0] * nb[1]);
+  for (std::size_t b = 0; b < nbins; ++b) {
+    if (bin_start[b] == bin_start[b + 1]) continue;
+    const int bx = static_cast<int>(b % nb[0]), by = static_cast<int>((b / nb[0]) % nb[1]);
+    const int bz = static_cast<int>(b / (static_cast<std::size_t>(nb[0]) * nb[1]));
     stencil.clear();
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
@@ -126,22 +165,44 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
           const int cb = (c[2] * nb[1] + c[1]) * nb[0] + c[0];
           if (std::find(stencil.begin(), stencil.end(), cb) == stencil.end()) stencil.push_back(cb);
         }
-    for (int cb : stencil) {
-      for (int s = bin_start[cb]; s < bin_start[cb + 1]; ++s) {
-        const int j = bin_items[s];
-        if (static_cast<std::size_t>(j) <= i) continue;
-        Vec3 d = p.x[i] - p.x[j];
-        if (any_periodic) d = domain.minimum_image(d);
-        const double reach = p.radius[i] + p.radius[j] + skin;
-        if (norm2(d) < reach * reach) partner.push_back(j);
+    for (int s = bin_start[b]; s < bin_start[b + 1]; ++s) {
+      const int i = bin_items[s];
+      const Vec3 xi = p.x[i];
+      const double ri = p.radius[i] + skin;
+      auto& out = found[i];
+      for (int cb : stencil) {
+        for (int t = bin_start[cb]; t < bin_start[cb + 1]; ++t) {
+          const int j = bin_items[t];
+          if (j <= i) continue;
+          Vec3 d = xi - p.x[j];
+          if (any_periodic) d = domain.minimum_image(d);
+          const double reach = ri + p.radius[j];
+          if (norm2(d) < reach * reach) out.push_back(j);
+        }
       }
     }
-    // Sorted partners give a deterministic pair order independent of the stencil order.
-    std::sort(partner.begin() + first[i], partner.end());
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    // Sorted partners give a deterministic pair order and allow the merge below.
+    std::sort(found[i].begin(), found[i].end());
+    partner.insert(partner.end(), found[i].begin(), found[i].end());
     first[i + 1] = static_cast<int>(partner.size());
   }
 
   history.assign(partner.size() * kHistorySize, 0.0);
+  if (same_order) {
+    for (std::size_t i = 0; i < n && i + 1 < old_first.size(); ++i) {
+      int a = old_first[i];
+      const int a_end = old_first[i + 1];
+      for (int k = first[i]; k < first[i + 1] && a < a_end; ++k) {
+        while (a < a_end && old_partner[a] < partner[k]) ++a;
+        if (a < a_end && old_partner[a] == partner[k])
+          std::copy_n(&old_history[static_cast<std::size_t>(a) * kHistorySize], kHistorySize,
+                      &history[static_cast<std::size_t>(k) * kHistorySize]);
+      }
+    }
+    return;
+  }
   if (old.empty()) return;
   for (std::size_t i = 0; i < n; ++i) {
     for (int k = first[i]; k < first[i + 1]; ++k) {

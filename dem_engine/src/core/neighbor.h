@@ -10,6 +10,10 @@ namespace dem {
 
 // Half neighbour list (each pair once, i < j) from cell binning with a skin. Contact history
 // lives beside the list and survives rebuilds, matched by particle tags.
+// Order of the particles along a cell grid (cells of size `cell`, x fastest), so that
+// neighbours in space are neighbours in memory.
+std::vector<std::size_t> spatial_order(const Particles& p, double cell);
+
 class NeighborList {
  public:
   double skin = 1e-4;   // neighbor SKIN bin (m)

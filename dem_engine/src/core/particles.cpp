@@ -59,6 +59,31 @@ void Particles::remove(const std::vector<char>& flagged) {
   for (auto& e : extras_) compact(e.data, flagged, e.width);
 }
 
+namespace {
+template <class T>
+void reorder(std::vector<T>& values, const std::vector<std::size_t>& order, std::size_t width = 1) {
+  std::vector<T> out(values.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    for (std::size_t c = 0; c < width; ++c) out[k * width + c] = values[order[k] * width + c];
+  values.swap(out);
+}
+}  // namespace
+
+void Particles::permute(const std::vector<std::size_t>& order) {
+  reorder(tag, order);
+  reorder(type, order);
+  reorder(mask, order);
+  reorder(x, order);
+  reorder(v, order);
+  reorder(f, order);
+  reorder(omega, order);
+  reorder(torque, order);
+  reorder(radius, order);
+  reorder(rmass, order);
+  reorder(density, order);
+  for (auto& e : extras_) reorder(e.data, order, e.width);
+}
+
 void Particles::set_radius(std::size_t i, double r) {
   radius[i] = r;
   rmass[i] = sphere_mass(r, density[i]);

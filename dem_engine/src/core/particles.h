@@ -26,6 +26,8 @@ class Particles {
                   double particle_radius, double particle_density);
   // Removes the particles whose flag is non-zero, keeping the order of the others.
   void remove(const std::vector<char>& flagged);
+  // Reorders the particles: new index k holds the particle that had index order[k].
+  void permute(const std::vector<std::size_t>& order);
   void set_radius(std::size_t i, double r);    // keeps density, updates mass
   void set_density(std::size_t i, double rho);  // keeps radius, updates mass
   std::int64_t next_tag() noexcept { return ++max_tag_; }

@@ -200,6 +200,9 @@ void Simulation::integrate_step() {
   if (!timestep_checked_) check_timestep();
   if (neighbor.due(atoms, step - last_build_step_)) {
     handle_lost_particles();
+    // Keep particles that are close in space close in memory: a large gain in cache hits for
+    // the pair loop at a cost of one sort per few rebuilds.
+    if (neighbor.builds() % 8 == 0) atoms.permute(spatial_order(atoms, 2.0 * max_radius() + neighbor.skin));
     neighbor.build(atoms, domain);
     last_build_step_ = step;
   }

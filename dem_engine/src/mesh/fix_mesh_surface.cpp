@@ -234,12 +234,7 @@ FixMeshSurfaceStressServo::FixMeshSurfaceStressServo(Simulation& sim, const Comm
 
 void FixMeshSurfaceStressServo::set_target(const std::string& word) {
   if (word.rfind("v_", 0) == 0) {
-    const std::string name = word.substr(2);
-    if (!sim_.variables.exists(name))
-      throw EngineError("target_val: variable '" + name + "' does not exist");
-    if (sim_.variables.style(name) != Variables::Style::Equal)
-      throw EngineError("target_val: variable '" + name + "' is not equal-style");
-    target_variable_ = name;
+    target_variable_ = word.substr(2);  // checked at init, as the variable may come later
     return;
   }
   target_variable_.clear();
@@ -301,6 +296,13 @@ void FixMeshSurfaceStressServo::init() {
     throw EngineError("vel_max < skin/(2*dt) required (vel_max " +
                       std::to_string(controller_.vel_max) + " m/s, skin/(2 dt) " +
                       std::to_string(sim_.neighbor.skin / (2.0 * sim_.dt)) + " m/s)");
+  if (!target_variable_.empty()) {
+    const std::string& name = target_variable_;
+    if (!sim_.variables.exists(name))
+      throw EngineError("target_val: variable '" + name + "' does not exist");
+    if (sim_.variables.style(name) != Variables::Style::Equal)
+      throw EngineError("target_val: variable '" + name + "' is not equal-style");
+  }
   if (!integrate_) speed_ = 0.0;
   mesh_.add_velocity(speed_ * axis_);
 }

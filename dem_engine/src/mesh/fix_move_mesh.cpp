@@ -48,7 +48,8 @@ FixMoveMesh::FixMoveMesh(Simulation& sim, const Command& command)
   mesh_fix_ = find_mesh_fix(sim, mesh_id_);
   if (mesh_fix_->self_moving())
     throw EngineError("move/mesh: mesh " + mesh_id_ +
-                      " is a servo wall, which does not allow superposition with moving mesh fixes");
+                      " is a servo wall, which does not allow superposition with moving mesh "
+                      "fixes");
   const std::string& kind = a[2];
   Vec3 origin, axis{0, 0, 1};
   std::size_t end = 0;

@@ -265,7 +265,8 @@ void FixWallGran::finish_step(double worst_ratio, long worst_tag, long overflow)
     std::snprintf(buf, sizeof buf, "%.3g", 100.0 * worst_ratio);
     throw EngineError("unstable simulation at step " + std::to_string(sim_.step) + ": particle " +
                       std::to_string(worst_tag) + " overlaps wall " + id() + " by " + buf +
-                      " % of its radius (time step too large, particles too soft or wall too fast)");
+                      " % of its radius (time step too large, particles too soft or wall too "
+                      "fast)");
   }
   if (overflow > 0 && !overflow_warned_) {
     overflow_warned_ = true;

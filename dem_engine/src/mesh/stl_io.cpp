@@ -145,7 +145,8 @@ std::vector<Triangle> parse_ascii_stl(const std::string& text, const std::string
         state = State::kEndFacet;
         break;
       case State::kEndFacet:
-        if (key != "endfacet") fail_at(path, line_no, "expected 'endfacet', got '" + words[0] + "'");
+        if (key != "endfacet")
+          fail_at(path, line_no, "expected 'endfacet', got '" + words[0] + "'");
         tris.push_back(current);
         state = State::kSolid;
         break;
@@ -164,8 +165,9 @@ std::vector<Triangle> read_stl(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw EngineError("cannot open STL file '" + path + "'");
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   if (bytes.size() >= 84) {
-    const std::uint32_t n = read_u32_le(reinterpret_cast<const unsigned char*>(bytes.data()) + 80);
+    const std::uint32_t n = read_u32_le(data + 80);
     if (84 + 50 * static_cast<std::uint64_t>(n) == bytes.size()) {
       if (n == 0) throw EngineError("STL file '" + path + "' (binary) contains no triangles");
       return parse_binary_stl(bytes, path);
@@ -177,7 +179,7 @@ std::vector<Triangle> read_stl(const std::string& path) {
     std::string reason = "is neither ASCII STL (it does not start with 'solid') nor binary STL";
     if (bytes.size() >= 84)
       reason += " (its size " + std::to_string(bytes.size()) + " bytes does not match the " +
-                std::to_string(read_u32_le(reinterpret_cast<const unsigned char*>(bytes.data()) + 80)) +
+                std::to_string(read_u32_le(data + 80)) +
                 " triangles of its header)";
     else
       reason += " (shorter than the 84-byte binary header)";

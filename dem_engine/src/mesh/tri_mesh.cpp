@@ -94,7 +94,8 @@ void TriMesh::add_velocity(const Vec3& v) {
 }
 
 void TriMesh::add_rotation_velocity(const Vec3& omega, const Vec3& origin) {
-  for (std::size_t k = 0; k < nodes_.size(); ++k) velocities_[k] += cross(omega, nodes_[k] - origin);
+  for (std::size_t k = 0; k < nodes_.size(); ++k)
+    velocities_[k] += cross(omega, nodes_[k] - origin);
   moving_ = true;
 }
 

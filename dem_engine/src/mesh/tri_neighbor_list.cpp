@@ -109,7 +109,8 @@ void TriangleNeighborList::build(const Particles& p, std::uint32_t group_bit,
             const int cell = (cz * nc[1] + cy) * nc[0] + cx;
             if (cell_start_[cell] == cell_start_[cell + 1]) continue;
             if (refine) {
-              const Vec3 centre{lo.x + (cx + 0.5) * h, lo.y + (cy + 0.5) * h, lo.z + (cz + 0.5) * h};
+              const Vec3 centre{lo.x + (cx + 0.5) * h, lo.y + (cy + 0.5) * h,
+                                lo.z + (cz + 0.5) * h};
               const ClosestPoint cp = closest_point_on_triangle(centre, a, b, c);
               const double reach = half_diag + cutoff;
               if (norm2(cp.point - centre) > reach * reach) continue;
@@ -136,7 +137,8 @@ void TriangleNeighborList::build(const Particles& p, std::uint32_t group_bit,
   for (std::size_t k = 0; k < pair_ref_.size(); ++k) refs[fill[pair_particle_[k]]++] = pair_ref_[k];
 }
 
-bool TriangleNeighborList::due(const Particles& p, const std::vector<const TriMesh*>& meshes) const {
+bool TriangleNeighborList::due(const Particles& p,
+                               const std::vector<const TriMesh*>& meshes) const {
   if (forced_ || p.size() != x_at_build_.size() || meshes != meshes_at_build_) return true;
   const double limit2 = 0.25 * skin_ * skin_;
   const std::size_t n = p.size();

@@ -1,0 +1,98 @@
+"""Engine benchmark: particle-steps per second of a packed 8 000-sphere heap at 1 and 2 threads.
+
+Usage: python dem_engine/bench/run_bench.py [--engine PATH] [--steps N]
+Prints, per variant (hertz + history + EPSD2, and with SJKR) and thread count, the dense-phase
+particle-steps per second and the peak resident memory per particle.
+"""
+
+import argparse
+import os
+import platform
+import re
+import resource
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent.parent
+
+
+def deck_text(cohesion: bool) -> str:
+    text = (HERE / "heap.in").read_text()
+    if cohesion:
+        style = 'variable model string "model hertz tangential history cohesion sjkr rolling_friction epsd2"'
+        text = text.replace(
+            'variable model string "model hertz tangential history rolling_friction epsd2"', style
+        )
+    return text.replace("if_cohesion_placeholder", "pair_style gran ${model}")
+
+
+def run_once(engine: str, cohesion: bool, threads: int, steps: int) -> dict:
+    with tempfile.TemporaryDirectory() as tmp:
+        deck = Path(tmp) / "heap.in"
+        deck.write_text(deck_text(cohesion))
+        env = dict(os.environ, OMP_NUM_THREADS=str(threads), OMP_PROC_BIND="close")
+        before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+        res = subprocess.run(
+            [
+                engine,
+                "-in",
+                "heap.in",
+                "-log",
+                "none",
+                "-noprogress",
+                "-var",
+                "dense_steps",
+                str(steps),
+            ],
+            cwd=tmp,
+            capture_output=True,
+            text=True,
+            env=env,
+            check=True,
+        )
+        peak_kib = max(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, before)
+    loops = re.findall(
+        r"Loop time of (\S+) on \d+ threads for (\d+) steps with (\d+) atoms \((\S+) particle-steps/s",
+        res.stdout,
+    )
+    seconds, n_steps, atoms, rate = loops[-1]
+    return {
+        "seconds": float(seconds),
+        "steps": int(n_steps),
+        "atoms": int(atoms),
+        "rate": float(rate),
+        "peak_kib": peak_kib,
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--engine",
+        default=shutil.which("dem_engine") or str(ROOT / "build" / "engine" / "dem_engine"),
+    )
+    parser.add_argument("--steps", type=int, default=4000)
+    args = parser.parse_args()
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
+        f"engine: {args.engine}"
+    )
+    for cohesion in (False, True):
+        name = "hertz+history+epsd2" + ("+sjkr" if cohesion else "")
+        rates = {}
+        for threads in (1, 2):
+            r = run_once(args.engine, cohesion, threads, args.steps)
+            rates[threads] = r["rate"]
+            print(
+                f"{name:28s} threads={threads}: {r['atoms']} particles, {r['steps']} dense steps "
+                f"in {r['seconds']:.2f} s -> {r['rate'] / 1e6:.2f} M particle-steps/s; "
+                f"peak memory {r['peak_kib'] / r['atoms']:.2f} KiB/particle"
+            )
+        print(f"{name:28s} speed-up 2 threads / 1 thread: {rates[2] / rates[1]:.2f}x")
+
+
+if __name__ == "__main__":
+    main()
