@@ -10,9 +10,17 @@ configfile: "config/config.yaml"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/design.smk"
+include: "workflow/rules/simulate.smk"
+include: "workflow/rules/bulk.smk"
+include: "workflow/rules/surrogate.smk"
+include: "workflow/rules/identify.smk"
 
 
 rule all:
     default_target: True
     input:
         design=DESIGN_TABLE,
+        dataset=DATASET,
+        table4=f"{RESULTS}/surrogates/table4.md",
+        table5=f"{RESULTS}/identification/table5.md",
+        verification=f"{RESULTS}/verification/verification.md",

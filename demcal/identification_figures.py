@@ -128,3 +128,13 @@ def cor_density_plot(
     fig.savefig(out, dpi=120)
     plt.close(fig)
     return out
+
+
+def note_figure(path: str | Path, text: str) -> Path:
+    """A figure that states why there is nothing to plot (keeps the report's layout)."""
+    fig, ax = plt.subplots(figsize=(6, 2))
+    ax.axis("off")
+    ax.text(0.5, 0.5, text, ha="center", va="center", wrap=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return Path(path)

@@ -1,13 +1,13 @@
-# Stage 1: the design of DEM cases (one row per case; ids, not floats, name the cases).
+# Stage 1: the design of DEM cases (one row per parameter set).
 
 
 rule design_table:
     output:
-        table=DESIGN_TABLE,
+        table=report(DESIGN_TABLE, category="Design", caption="../report/design.rst"),
     log:
         f"{LOGS}/design/design_table.log",
     params:
-        spec=config["design"],
+        section=config["design"],
     localrule: True
     conda:
         CONDA_ENV

@@ -1,0 +1,82 @@
+"""Running one deck with the configured engine and recording how it went."""
+
+import json
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+
+def engine_command(template: str, deck: str, threads: int) -> list[str]:
+    """The command line for one deck, from the ``engine.command`` template.
+
+    Parameters
+    ----------
+    template : str
+        E.g. ``"dem_engine -in {deck}"`` or ``"mpirun -np {threads} lmp_auto -in {deck}"``.
+    deck : str
+        Deck file name, relative to the case directory.
+    threads : int
+        Threads or MPI ranks.
+    """
+    try:
+        text = template.format(deck=deck, threads=threads)
+    except (KeyError, IndexError) as exc:
+        raise ValueError(
+            f"engine.command {template!r}: unknown placeholder {exc}; use {{deck}} and {{threads}}"
+        ) from exc
+    cmd = shlex.split(text)
+    if not cmd:
+        raise ValueError("engine.command is empty")
+    # The bundled engine is installed beside the Python interpreter of the environment, which
+    # need not be on PATH when snakemake is called by its full path.
+    search = os.pathsep.join([os.environ.get("PATH", ""), str(Path(sys.executable).parent)])
+    found = shutil.which(cmd[0], path=search)
+    if found is None:
+        raise FileNotFoundError(
+            f"engine.command {template!r}: program {cmd[0]!r} not found (run `make engine`, "
+            "activate .venv, or give the full path)"
+        )
+    cmd[0] = found
+    return cmd
+
+
+def run_deck(case_dir: str | Path, deck: str, template: str, threads: int) -> dict:
+    """Run ``deck`` in ``case_dir`` and write ``status.json`` there.
+
+    The engine's screen output goes to ``engine.out``/``engine.err`` in the case directory and
+    its log to ``log.liggghts``. A failed run is recorded (status ``failed`` with the engine's
+    error line), not raised, so that one bad case does not stop a study; a missing engine is a
+    set-up error and raises ``FileNotFoundError`` before anything is written.
+
+    Returns
+    -------
+    dict
+        The status record: status, returncode, seconds, command, error.
+    """
+    case_dir = Path(case_dir)
+    cmd = engine_command(template, deck, threads)
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    start = time.monotonic()
+    with (case_dir / "engine.out").open("w") as out, (case_dir / "engine.err").open("w") as err:
+        proc = subprocess.run(cmd, cwd=case_dir, stdout=out, stderr=err, env=env, check=False)
+        returncode = proc.returncode
+    seconds = time.monotonic() - start
+    errors = [
+        line.strip()
+        for line in (case_dir / "engine.err").read_text().splitlines()
+        if line.startswith("ERROR")
+    ]
+    status = {
+        "status": "ok" if returncode == 0 else "failed",
+        "returncode": returncode,
+        "seconds": round(seconds, 3),
+        "command": cmd,
+        "threads": threads,
+        "error": errors[-1] if errors else ("" if returncode == 0 else f"exit code {returncode}"),
+    }
+    (case_dir / "status.json").write_text(json.dumps(status, indent=2) + "\n")
+    return status

@@ -1,0 +1,83 @@
+"""Synthetic "measured" data: the engine run at known parameters, optionally with noise.
+
+The true parameters live in a file that the workflow never reads, so that tests can check that
+the identification recovers them.
+"""
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from demcal.bulk_values import extract
+from demcal.decks import render_case
+from demcal.dem_run import run_deck
+
+
+def simulate_reference(
+    parameters: Mapping[str, float], config: Mapping[str, Any], work_dir: str | Path
+) -> pd.DataFrame:
+    """Bulk values of both virtual tests at ``parameters`` (tidy rows; raises if a run fails)."""
+    work_dir = Path(work_dir)
+    frames = []
+    cases: list[tuple[str, dict]] = [("angle_of_repose", {"case_id": "reference", **parameters})]
+    for k, stress in enumerate(config["shear_cell"]["normal_stresses"], start=1):
+        cases.append(
+            ("shear_cell", {"case_id": f"reference_s{k}", "normal_stress": stress, **parameters})
+        )
+    for test, case in cases:
+        case_dir = work_dir / test / case["case_id"]
+        info = render_case(test, case, config, case_dir)
+        status = run_deck(
+            case_dir,
+            Path(info["deck"]).name,
+            config["engine"]["command"],
+            int(config["engine"]["threads"]),
+        )
+        if status["status"] != "ok":
+            raise RuntimeError(f"reference run {case_dir} failed: {status['error']}")
+        rows = extract(test, case_dir)
+        rows["test"] = test
+        frames.append(rows)
+    return pd.concat(frames, ignore_index=True)
+
+
+def experiment_record(
+    bulk: pd.DataFrame, material: str, noise: float, seed: int, source: str
+) -> dict[str, Any]:
+    """An experiment-file mapping from reference bulk values, with relative Gaussian noise.
+
+    Parameters
+    ----------
+    bulk : DataFrame
+        Output of :func:`simulate_reference`.
+    noise : float
+        Relative standard deviation of the measurement noise (e.g. 0.01), also written as sd.
+    """
+    rng = np.random.default_rng(seed)
+
+    def noisy(value: float) -> float:
+        return float(value * (1.0 + noise * rng.standard_normal())) if noise > 0 else float(value)
+
+    record: dict[str, Any] = {"material": material, "source": source}
+    aor = bulk[bulk["test"] == "angle_of_repose"]
+    if len(aor) and np.isfinite(aor["aor"].iloc[0]):
+        value = float(aor["aor"].iloc[0])
+        record["angle_of_repose"] = {"value": round(noisy(value), 4), "sd": round(noise * value, 4)}
+    conditions = []
+    shear = bulk[bulk["test"] == "shear_cell"]
+    for _, row in shear.sort_values(["normal_stress", "P"]).iterrows():
+        entry: dict[str, float] = {
+            "normal_stress": float(row["normal_stress"]),
+            "P": float(row["P"]),
+        }
+        for name in ("mu_psh", "mu_sh", "rho_b"):
+            if np.isfinite(row[name]):
+                entry[name] = round(noisy(float(row[name])), 6)
+                entry[f"{name}_sd"] = round(noise * float(row[name]), 6)
+        conditions.append(entry)
+    if conditions:
+        record["shear_cell"] = conditions
+    return record

@@ -1,0 +1,21 @@
+"""Run one deck with the configured engine; a failed run is recorded, not raised."""
+
+from pathlib import Path
+
+from demcal.dem_run import run_deck
+from demcal.rule_log import rule_log
+
+
+def main(deck: str, command: str, threads: int, log: str) -> None:
+    with rule_log(log) as logger:
+        status = run_deck(Path(deck).parent, Path(deck).name, command, threads)
+        if status["status"] == "ok":
+            logger.info("%s finished in %.1f s", deck, status["seconds"])
+        else:
+            # Recorded in status.json, excluded from training and counted in the report.
+            logger.warning("%s FAILED: %s", deck, status["error"])
+
+
+if __name__ == "__main__":
+    sm = snakemake  # noqa: F821
+    main(sm.input.deck, sm.params.command, sm.threads, sm.log[0])

@@ -1,0 +1,340 @@
+"""Derived quantities of the shear-cell deck: geometry, particle counts, forces, time step and
+the step/offset bookkeeping of the Schulze sequence, against hand-computed values."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import pytest
+
+from demcal.config import validate_config
+from demcal.shear_cell_setup import (
+    SetupError,
+    inertial_number,
+    material_setup,
+    prime_seed,
+    rayleigh_time,
+    round_down_sig,
+    shear_cell_setup,
+    shear_cell_youngs_modulus,
+    size_distribution,
+    steps_for,
+    time_step,
+)
+from demcal.size_distribution import monodisperse, sinter_fines
+
+CASE = {
+    "case_id": "c0001",
+    "coefficientFriction": 0.5,
+    "coefficientRollingFriction": 0.3,
+    "coefficientRestitution": 0.6,
+    "density": 2500.0,
+    "normal_stress": 2029.0,
+}
+
+
+def settings(**cell: object) -> dict:
+    """Validated default configuration with a monodisperse 1 mm radius and cell overrides."""
+    cfg = validate_config({"particles": {"distribution": "monodisperse", "radius": 0.001}}, "t")
+    cfg["shear_cell"].update(cell)
+    return cfg
+
+
+def setup_for(dCylDp: float = 10.0, stress: float = 2029.0, **cell: object):
+    cfg = settings(**cell)
+    dist = size_distribution(cfg["particles"])
+    mat = material_setup(CASE, cfg["material"], dist)
+    return shear_cell_setup(dCylDp, stress, dist, mat, cfg["shear_cell"], 7), mat, dist
+
+
+# ---------------------------------------------------------------------------------------------
+# particles, material, time step
+
+
+def test_size_distribution_from_settings() -> None:
+    mono = size_distribution({"distribution": "monodisperse", "radius": 0.002})
+    assert list(mono.radii) == [0.002]
+    fines = size_distribution({"distribution": "sinter_fines", "scale": 2.0, "classes": 4})
+    assert fines.radii.tolist() == pytest.approx([2.0e-3, 1.6e-3, 1.25e-3, 1.0e-3])
+    assert fines.mass_fractions.sum() == pytest.approx(1.0)
+    # The four largest sieve classes hold 0.4539 + 0.1571 + 0.1033 + 0.2264 of the mass.
+    assert fines.mass_fractions[0] == pytest.approx(0.4539 / 0.9407)
+
+
+@pytest.mark.parametrize(
+    ("particles", "key"),
+    [
+        ({"distribution": "cubes", "radius": 1e-3}, "particles.distribution"),
+        ({"distribution": "monodisperse", "radius": -1e-3}, "particles.radius"),
+        ({"distribution": "sinter_fines", "scale": 1.0, "classes": 7}, "particles.classes"),
+    ],
+)
+def test_size_distribution_errors_name_the_key(particles: dict, key: str) -> None:
+    with pytest.raises(SetupError, match=key.replace(".", r"\.")):
+        size_distribution(particles)
+
+
+def test_rayleigh_time_reproduces_the_papers_time_step_fraction() -> None:
+    # Paper: dt = 1e-6 s was 1.29-1.53 % of the Rayleigh time (mean R 0.732 mm, 10 MPa, 0.4,
+    # rho_p 2500-3500). The formula gives 1.31 % and 1.55 %.
+    heavy = 1e-6 / rayleigh_time(0.732e-3, 3500.0, 1e7, 0.4)
+    light = 1e-6 / rayleigh_time(0.732e-3, 2500.0, 1e7, 0.4)
+    assert heavy == pytest.approx(0.0131, abs=3e-4)
+    assert light == pytest.approx(0.0155, abs=3e-4)
+
+
+def test_rayleigh_time_hand_value() -> None:
+    # G = 1e6 / 2.8, sqrt(2800 / 357142.857) = 0.0885438, denominator 0.1631 * 0.4 + 0.8766.
+    expected = math.pi * 2e-3 * math.sqrt(2800.0 / (1e6 / 2.8)) / 0.94184
+    assert rayleigh_time(2e-3, 2800.0, 1e6, 0.4) == pytest.approx(expected, rel=1e-12)
+
+
+def test_round_down_sig_is_exact_and_below() -> None:
+    assert round_down_sig(4.44999e-5) == 4.44e-5
+    assert repr(round_down_sig(4.44999e-5)) == "4.44e-05"
+    assert round_down_sig(1.0) == 1.0
+    assert round_down_sig(9.999e-7, 2) == 9.9e-7
+    with pytest.raises(ValueError):
+        round_down_sig(0.0)
+
+
+def test_time_step_fixed_or_from_rayleigh_time() -> None:
+    dist = sinter_fines(scale=2.0, n_largest=4)
+    assert time_step(dist, 2500.0, 1e7, 0.4, 1e-6, 0.15) == 1e-6
+    dt = time_step(dist, 2500.0, 2e6, 0.4, 0.0, 0.15)
+    t_r = rayleigh_time(1e-3, 2500.0, 2e6, 0.4)  # smallest radius 1 mm
+    assert 0.999 * 0.15 * t_r < dt <= 0.15 * t_r
+
+
+def test_material_setup_switches_and_wall_friction() -> None:
+    cfg = settings()
+    dist = monodisperse(1e-3)
+    mat = material_setup(CASE, cfg["material"], dist)
+    assert (mat.cohesion, mat.rolling_friction, mat.wall_friction) == (False, True, 0.5)
+    assert mat.pair_matrix(0.5, 0.2) == [0.5, 0.2, 0.2, 0.2]
+    sticky = material_setup(
+        {**CASE, "cohesionEnergyDensity": 3e4, "wallFriction": 0.2}, cfg["material"], dist
+    )
+    assert sticky.cohesion and sticky.cohesion_energy_density == 3e4
+    assert sticky.wall_friction == 0.2
+    assert material_setup(CASE, cfg["material"], dist, 3e6).youngs_modulus == 3e6
+
+
+def test_youngs_modulus_scales_with_stress_when_asked() -> None:
+    cfg = settings()
+    assert shear_cell_youngs_modulus(CASE, cfg["material"], cfg["shear_cell"]) == 1e7
+    cfg["shear_cell"]["youngs_modulus_per_stress"] = 1000.0
+    assert shear_cell_youngs_modulus(CASE, cfg["material"], cfg["shear_cell"]) == 2.029e6
+    own = {**CASE, "youngsModulus": 5e6}
+    assert shear_cell_youngs_modulus(own, cfg["material"], cfg["shear_cell"]) == 5e6
+
+
+def test_prime_seeds_are_distinct_large_primes() -> None:
+    seeds = [prime_seed(20240611, k) for k in range(8)]
+    assert len(set(seeds)) == 8 and min(seeds) > 10000
+    for s in seeds:
+        assert all(s % d for d in range(2, int(s**0.5) + 1))
+    assert prime_seed(7, 3) == prime_seed(7, 3)
+    assert prime_seed(7, 0) != prime_seed(8, 0)
+
+
+def test_steps_and_inertial_number() -> None:
+    assert steps_for(1e-3, 1e-5) == 100
+    assert steps_for(1.0000001e-3, 1e-5) == 101
+    assert steps_for(1e-9, 1e-5) == 1
+    # v = 0.01 m/s, band of 10 diameters, p = 2500 Pa, rho = 2500: sqrt(p / rho) = 1 m/s.
+    assert inertial_number(0.01, 10.0, 2500.0, 2500.0) == pytest.approx(1e-3)
+
+
+# ---------------------------------------------------------------------------------------------
+# geometry and counts
+
+
+def test_geometry_and_particle_count_of_monodisperse_cell() -> None:
+    s, _, _ = setup_for(dCylDp=20.0, overfill=0.0)
+    assert s.radius == pytest.approx(20 * 1e-3)
+    assert s.fill_height == pytest.approx(1.5 * s.radius)
+    assert s.z_shear == pytest.approx(0.5 * 1.5 * s.radius)
+    # PHYSICS.md: about 0.73 dCylDp^3 equal spheres fill 1.5 R at a packing fraction of 0.65.
+    assert s.n_particles == round(0.65 * 1.5 * 0.75 * 20**3)
+    assert s.n_particles == pytest.approx(5800, rel=0.02)
+    big, _, _ = setup_for(dCylDp=40.0, overfill=0.0)
+    assert big.n_particles == pytest.approx(47000, rel=0.02)
+
+
+def test_overfill_adds_particles_and_scrape_height_is_fill_height() -> None:
+    flat, _, _ = setup_for(overfill=0.0)
+    more, _, _ = setup_for(overfill=0.5)
+    assert more.n_particles / flat.n_particles == pytest.approx(2.0 / 1.5, rel=2e-3)
+    assert more.scrape_height == more.fill_height
+    assert more.insertion_zhi > flat.insertion_zhi
+
+
+def test_reference_radius_is_mass_weighted_mean() -> None:
+    cfg = settings()
+    cfg["particles"] = {"distribution": "sinter_fines", "scale": 1.0, "classes": 6}
+    dist = size_distribution(cfg["particles"])
+    mat = material_setup(CASE, cfg["material"], dist)
+    s = shear_cell_setup(20.0, 2029.0, dist, mat, cfg["shear_cell"], 7)
+    assert s.reference_radius == pytest.approx(dist.mass_mean_radius)
+    assert s.radius == pytest.approx(20.0 * 0.778e-3, rel=2e-3)
+
+
+def test_insertion_region_inside_the_polygonal_tube() -> None:
+    s, _, dist = setup_for()
+    flat = s.radius * math.cos(math.pi / s.n_segments)
+    assert s.insertion_radius + dist.max_radius < flat
+    # Volume fraction of the insertion region equals the configured one.
+    solid = s.n_particles * dist.mean_particle_volume
+    region = math.pi * s.insertion_radius**2 * (s.insertion_zhi - s.insertion_zlo)
+    assert solid / region == pytest.approx(0.3)
+    assert s.wall_top > s.insertion_zhi
+
+
+def test_too_small_cell_is_rejected() -> None:
+    with pytest.raises(SetupError, match="dCylDp"):
+        setup_for(dCylDp=2.5)
+
+
+# ---------------------------------------------------------------------------------------------
+# loads, speeds, Schulze sequence
+
+
+def test_forces_speeds_and_durations() -> None:
+    s, _, _ = setup_for(stress=10070.0)
+    area = math.pi * s.radius**2
+    assert s.preshear_force == pytest.approx(10070.0 * area)
+    assert s.lid_target_val == -s.preshear_force
+    assert s.shear_speed == pytest.approx(3.0 * 1e-3)
+    assert s.preshear_time == pytest.approx(0.1875 * s.radius / s.shear_speed)
+    assert s.shear_time == pytest.approx(0.95 * s.preshear_time)
+    assert s.servo_vel_max == pytest.approx(5.0 * s.shear_speed)
+    for cycle, p in zip(s.cycles, (0.4, 0.6, 0.8, 1.0), strict=True):
+        assert cycle.P == p
+        assert cycle.shear_force == pytest.approx(p * s.preshear_force)
+    smallest = 10070.0 * 0.4
+    assert s.inertial_number_min_stress == pytest.approx(
+        s.shear_speed / (10.0 * math.sqrt(smallest / 2500.0))
+    )
+
+
+def test_segments_are_contiguous_and_cover_the_run() -> None:
+    s, _, _ = setup_for()
+    segs = s.segments
+    assert segs[0].start_step == s.fill_steps
+    for a, b in itertools.pairwise(segs):
+        assert b.start_step == a.end_step
+        assert b.offset_start == pytest.approx(a.offset_end, abs=1e-15)
+    assert s.total_steps == segs[-1].end_step
+    assert [g.phase for g in segs[:4]] == [0, 1, 2, 3]
+
+
+def test_return_mode_starts_every_cycle_at_zero_offset_towards_minus_x() -> None:
+    s, _, _ = setup_for(cycles="return")
+    travel = s.shear_speed * s.timestep
+    for cycle in s.cycles:
+        assert cycle.direction == -1
+        assert cycle.offset_preshear_start == pytest.approx(0.0, abs=1e-12)
+        n = (cycle.preshear_end_step - cycle.preshear_start_step) + (
+            cycle.shear_end_step - cycle.shear_start_step
+        )
+        assert cycle.offset_shear_end == pytest.approx(-n * travel, rel=1e-12)
+    # Pre-shear travel is 0.1875 R within one step.
+    first = s.cycles[0]
+    moved = (first.preshear_end_step - first.preshear_start_step) * travel
+    assert abs(moved - 0.1875 * s.radius) <= travel
+    returns = [g for g in s.segments if g.phase == 0 and g.moving]
+    assert len(returns) == 3
+    assert all(g.velocity > 0 for g in returns)
+    assert s.max_offset == pytest.approx(-min(c.offset_shear_end for c in s.cycles))
+
+
+def test_alternate_mode_swings_symmetrically() -> None:
+    s, _, _ = setup_for(cycles="alternate")
+    assert [c.direction for c in s.cycles] == [-1, 1, -1, 1]
+    h = s.cycles[0].offset_preshear_start
+    assert h > 0
+    for cycle in s.cycles:
+        assert abs(cycle.offset_preshear_start) == pytest.approx(
+            h, abs=2 * s.shear_speed * s.timestep
+        )
+        assert abs(cycle.offset_shear_end) <= h + 2 * s.shear_speed * s.timestep
+    position = s.segments[1]
+    assert position.phase == 0 and position.moving and position.velocity > 0
+
+
+def test_single_load_condition_runs_one_cycle() -> None:
+    s, _, _ = setup_for(P=[0.6])
+    assert len(s.cycles) == 1 and s.cycles[0].P == 0.6
+    assert [g.phase for g in s.segments] == [0, 1, 2, 3]
+    assert s.snapshot_step == s.cycles[0].preshear_end_step
+    assert [g.snapshot for g in s.segments] == [False, True, False, False]
+
+
+def test_servo_gains_scale_with_the_target() -> None:
+    s, _, _ = setup_for(servo_kp=2.0, servo_ki=0.5)
+    for g in s.segments:
+        factor = g.target_force / s.preshear_force
+        assert g.ctrl == pytest.approx((2.0 * factor, 0.5 * factor, 0.0))
+        assert g.target_val == -g.target_force
+    unload = [g for g in s.segments if g.phase == 2]
+    assert all(g.target_force == pytest.approx(1e-3 * s.preshear_force) for g in unload)
+
+
+def test_travel_per_step_integrates_to_the_offsets() -> None:
+    s, _, _ = setup_for(cycles="alternate")
+    for g in s.segments:
+        assert g.offset_end == pytest.approx(g.offset_start + g.steps * g.travel_per_step)
+        assert g.travel_per_step == pytest.approx(g.velocity * s.timestep)
+
+
+def test_box_holds_the_walls_in_every_position() -> None:
+    for mode in ("return", "alternate"):
+        s, _, _ = setup_for(cycles=mode)
+        reach = s.radius + s.flange_width + s.max_offset
+        assert s.box_lo[0] < -reach and s.box_hi[0] > reach
+        assert s.box_hi[1] > s.radius + s.flange_width
+        assert s.box_hi[2] > s.wall_top and s.box_lo[2] < 0.0
+        assert s.flange_width > s.max_offset
+
+
+def test_print_interval_gives_the_requested_samples() -> None:
+    s, _, _ = setup_for(samples_per_preshear=100)
+    n_psh = s.cycles[0].preshear_end_step - s.cycles[0].preshear_start_step
+    assert n_psh // s.print_every >= 100
+    assert n_psh // s.print_every < 200
+
+
+def test_servo_speed_above_skin_limit_names_the_key() -> None:
+    with pytest.raises(SetupError, match=r"shear_cell\.servo_speed"):
+        setup_for(servo_speed=1e6)
+
+
+@pytest.mark.parametrize(
+    ("cell", "key"),
+    [
+        ({"P": [0.0]}, r"shear_cell\.P"),
+        ({"P": []}, r"shear_cell\.P"),
+        ({"cycles": "zigzag"}, r"shear_cell\.cycles"),
+        ({"shear_plane": 1.5}, r"shear_cell\.shear_plane"),
+        ({"servo_kp": 0.0, "servo_ki": 0.0, "servo_kd": 0.0}, "servo_kp"),
+    ],
+)
+def test_bad_settings_name_the_key(cell: dict, key: str) -> None:
+    with pytest.raises(SetupError, match=key):
+        setup_for(**cell)
+
+
+def test_missing_key_is_named() -> None:
+    cfg = settings()
+    del cfg["shear_cell"]["shear_speed"]
+    dist = size_distribution(cfg["particles"])
+    mat = material_setup(CASE, cfg["material"], dist)
+    with pytest.raises(KeyError, match=r"shear_cell\.shear_speed"):
+        shear_cell_setup(10.0, 2029.0, dist, mat, cfg["shear_cell"], 7)
+
+
+def test_non_positive_stress_is_rejected() -> None:
+    with pytest.raises(SetupError, match="normal_stress"):
+        setup_for(stress=0.0)

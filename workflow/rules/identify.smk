@@ -1,0 +1,93 @@
+# Stage 5: screen the candidate grid against the measurements; Table 5, Figs. 6-9, the
+# identified parameter set, and a verification DEM run of both tests at that set.
+
+FIGURES = {
+    "fig6": "fig6_box_ssc.png",
+    "fig7": "fig7_density_ssc.png",
+    "fig8": "fig8_box_aor.png",
+    "fig9": "fig9_box_ssc_aor.png",
+}
+
+
+rule identify:
+    input:
+        models=expand(f"{RESULTS}/surrogates/{{output}}/model.pt", output=OUTPUTS_TRAINED),
+        experiment=config["experiment"],
+    output:
+        table5=report(
+            f"{RESULTS}/identification/table5.md",
+            category="Identification",
+            caption="../report/table5.rst",
+        ),
+        table5_csv=f"{RESULTS}/identification/table5.csv",
+        identified=IDENTIFIED,
+        material=f"{RESULTS}/identification/material.in",
+        **{
+            key: report(
+                f"{RESULTS}/identification/{name}",
+                category="Identification",
+                caption=f"../report/{key}.rst",
+            )
+            for key, name in FIGURES.items()
+        },
+    log:
+        f"{LOGS}/identification/identify.log",
+    params:
+        outputs=OUTPUTS_TRAINED,
+        screening=config["screening"],
+        constants={
+            "mu_psh": {"dCylDp": config["shear_cell"]["dCylDp"]},
+            "mu_sh": {"dCylDp": config["shear_cell"]["dCylDp"]},
+            "rho_b": {"dCylDp": config["shear_cell"]["dCylDp"]},
+            "aor": {"dCylDp": config["angle_of_repose"]["dCylDp"]},
+        },
+    threads: config["screening"]["threads"]
+    resources:
+        runtime=resource("training", "runtime", 30),
+        mem_mb=resource("training", "mem_mb", 4000),
+    conda:
+        CONDA_ENV
+    script:
+        "../../scripts/identify.py"
+
+
+rule render_verification:
+    input:
+        identified=IDENTIFIED,
+    output:
+        deck=f"{RESULTS}/verification/{{test}}/{{case}}/in.{{test}}",
+        info=f"{RESULTS}/verification/{{test}}/{{case}}/case.json",
+    log:
+        f"{LOGS}/render/verification/{{test}}/{{case}}.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    script:
+        "../../scripts/render_verification.py"
+
+
+rule verification_table:
+    input:
+        bulk=[
+            f"{RESULTS}/verification/{test}/{case}/bulk.csv"
+            for test in TESTS
+            for case in VERIFICATION_CASES[test]
+        ],
+        experiment=config["experiment"],
+        identified=IDENTIFIED,
+    output:
+        table=report(
+            f"{RESULTS}/verification/verification.md",
+            category="Identification",
+            caption="../report/verification.rst",
+        ),
+        csv=f"{RESULTS}/verification/verification.csv",
+    log:
+        f"{LOGS}/verification/verification_table.log",
+    params:
+        tolerance=config["screening"]["tolerance"],
+    localrule: True
+    conda:
+        CONDA_ENV
+    script:
+        "../../scripts/verification_table.py"

@@ -1,0 +1,65 @@
+# Stage 4: one network per bulk value (hidden-size sweep), baselines and Table 4.
+
+
+rule train_surrogate:
+    input:
+        dataset=DATASET,
+    output:
+        model=f"{RESULTS}/surrogates/{{output}}/model.pt",
+        table4=f"{RESULTS}/surrogates/{{output}}/table4.csv",
+        sweep=f"{RESULTS}/surrogates/{{output}}/sweep.csv",
+        parity_ann=report(
+            f"{RESULTS}/surrogates/{{output}}/parity_ann.png",
+            category="Surrogates",
+            subcategory="{output}",
+            caption="../report/parity.rst",
+        ),
+        parity_bayesian=report(
+            f"{RESULTS}/surrogates/{{output}}/parity_bayesian.png",
+            category="Surrogates",
+            subcategory="{output}",
+            caption="../report/parity.rst",
+        ),
+        parity_gaussian=report(
+            f"{RESULTS}/surrogates/{{output}}/parity_gaussian.png",
+            category="Surrogates",
+            subcategory="{output}",
+            caption="../report/parity.rst",
+        ),
+        r2_size=report(
+            f"{RESULTS}/surrogates/{{output}}/r2_vs_hidden_size.png",
+            category="Surrogates",
+            subcategory="{output}",
+            caption="../report/r2_size.rst",
+        ),
+    log:
+        f"{LOGS}/surrogates/{{output}}.log",
+    params:
+        settings=config["surrogate"],
+    threads: 1
+    resources:
+        runtime=resource("training", "runtime", 30),
+        mem_mb=resource("training", "mem_mb", 2000),
+    conda:
+        CONDA_ENV
+    script:
+        "../../scripts/train_surrogate.py"
+
+
+rule table4:
+    input:
+        tables=expand(f"{RESULTS}/surrogates/{{output}}/table4.csv", output=OUTPUTS_TRAINED),
+        sweeps=expand(f"{RESULTS}/surrogates/{{output}}/sweep.csv", output=OUTPUTS_TRAINED),
+    output:
+        markdown=report(
+            f"{RESULTS}/surrogates/table4.md", category="Surrogates", caption="../report/table4.rst"
+        ),
+    log:
+        f"{LOGS}/surrogates/table4.log",
+    params:
+        outputs=OUTPUTS_TRAINED,
+    localrule: True
+    conda:
+        CONDA_ENV
+    script:
+        "../../scripts/write_table4.py"
