@@ -9,11 +9,21 @@ configfile: "config/config.yaml"
 
 
 include: "workflow/rules/common.smk"
+
+
+wildcard_constraints:
+    test="shear_cell|angle_of_repose",
+    case=r"[A-Za-z0-9]+(_s\d+)?",
+    stage="cases|verification|discrepancy/probes|discrepancy/extended|discrepancy/verification",
+    output="mu_psh|mu_sh|rho_b|aor",
+
+
 include: "workflow/rules/design.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/bulk.smk"
 include: "workflow/rules/surrogate.smk"
 include: "workflow/rules/identify.smk"
+include: "workflow/rules/application.smk"
 
 
 rule all:
@@ -24,3 +34,7 @@ rule all:
         table4=f"{RESULTS}/surrogates/table4.md",
         table5=f"{RESULTS}/identification/table5.md",
         verification=f"{RESULTS}/verification/verification.md",
+        segregation=f"{RESULTS}/application/segregation.csv",
+        segregation_index=f"{RESULTS}/application/segregation_index.json",
+        fig10=f"{RESULTS}/application/fig10_layout.png",
+        fig11=f"{RESULTS}/application/fig11_segregation.png",

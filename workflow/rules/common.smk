@@ -9,31 +9,22 @@ LOGS = "logs"
 CONDA_ENV = "../envs/demcal.yaml"
 DESIGN_TABLE = f"{RESULTS}/design/cases.csv"
 DATASET = f"{RESULTS}/bulk/dataset.csv"
-BULK_OUTPUTS = {"shear_cell": ["mu_psh", "mu_sh", "rho_b"], "angle_of_repose": ["aor"]}
 IDENTIFIED = f"{RESULTS}/identification/identified_parameters.json"
+OUTPUTS_TRAINED = ["mu_psh", "mu_sh", "rho_b", "aor"]
 
 # The design is a pure function of the configuration, so the case ids are known when the
 # workflow is parsed; wildcards carry these ids, never floats.
 DESIGN = design_from_config(config)
 CASES = {test: case_ids(config, DESIGN, test) for test in TESTS}
+N_STRESSES = len(config["shear_cell"]["normal_stresses"])
+VERIFICATION_CASES = {
+    "shear_cell": [f"identified_s{k + 1}" for k in range(N_STRESSES)],
+    "angle_of_repose": ["identified"],
+}
 
 
 def resource(kind, key, default):
-    """A per-rule-kind resource from the config's `resources` section, if present."""
-    return config.get("resources", {}).get(kind, {}).get(key, default)
+    """Resource `key` for jobs of `kind` at the study scale (resources.<profile>.<kind>)."""
+    per_profile = config.get("resources", {}).get(config["profile"], {})
+    return per_profile.get(kind, {}).get(key, default)
 
-
-def case_path(stage, test, case, name):
-    return f"{RESULTS}/{stage}/{test}/{case}/{name}"
-
-
-wildcard_constraints:
-    test="shear_cell|angle_of_repose",
-    case=r"[A-Za-z0-9]+(_s\d+)?",
-    stage="cases|verification|discrepancy/probes|discrepancy/extended|discrepancy/verification",
-    output="mu_psh|mu_sh|rho_b|aor",
-OUTPUTS_TRAINED = ["mu_psh", "mu_sh", "rho_b", "aor"]
-VERIFICATION_CASES = {
-    "shear_cell": [f"identified_s{k + 1}" for k in range(len(config["shear_cell"]["normal_stresses"]))],
-    "angle_of_repose": ["identified"],
-}
