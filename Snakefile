@@ -13,7 +13,7 @@ include: "workflow/rules/common.smk"
 
 wildcard_constraints:
     test="shear_cell|angle_of_repose",
-    case=r"[A-Za-z0-9]+(_s\d+)?",
+    case=r"[A-Za-z0-9]+(_s\d+(_p\d+)?)?",
     stage="cases|verification|discrepancy/probes|discrepancy/extended|discrepancy/verification",
     output="mu_psh|mu_sh|rho_b|aor",
 

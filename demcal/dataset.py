@@ -7,6 +7,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from demcal.bulk_values import extract
+
 #: Contact and geometry parameters a case may carry (LIGGGHTS names).
 PARAMETERS = (
     "coefficientFriction",
@@ -40,7 +42,8 @@ def case_rows(
     extract : callable
         ``extract(test, case_dir) -> DataFrame`` of bulk values (see ``demcal.bulk_values``).
     p_values : sequence of float
-        Shear load fractions, for the rows of a failed shear-cell case.
+        Shear load fractions, for the rows of a failed shear-cell case that ran all P values
+        as cycles (a separate-run case carries its own P).
     """
     case_dir = Path(case_dir)
     info = json.loads((case_dir / "case.json").read_text())
@@ -55,11 +58,13 @@ def case_rows(
     else:
         rows, status_text, error = None, "failed", status.get("error", "")
     if rows is None:
-        n = len(p_values) if test == "shear_cell" else 1
+        # One row per load condition the case was meant to produce.
+        loads = [case["P"]] if "P" in case else list(p_values)
+        n = len(loads) if test == "shear_cell" else 1
         rows = pd.DataFrame({"case_id": [case["case_id"]] * n})
         if test == "shear_cell":
             rows["normal_stress"] = case["normal_stress"]
-            rows["P"] = list(p_values)
+            rows["P"] = loads
         for out in OUTPUTS[test]:
             rows[out] = math.nan
     rows["test"] = test
@@ -90,3 +95,8 @@ def usable(data: pd.DataFrame, output: str) -> pd.DataFrame:
     """Rows fit for training on ``output``: the run succeeded and the value is finite."""
     ok = (data["status"] == "ok") & data[output].notna()
     return data[ok]
+
+
+def write_case_rows(test: str, case_dir: str | Path, p_values: Sequence[float], path: str) -> None:
+    """Extract the bulk rows of one case (see :func:`case_rows`) and write them as CSV."""
+    case_rows(test, case_dir, extract, p_values).to_csv(path, index=False, float_format="%.10g")

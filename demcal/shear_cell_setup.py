@@ -239,15 +239,17 @@ def shear_cell_youngs_modulus(
     """Young's modulus of a shear-cell case, Pa.
 
     A case column youngsModulus wins; otherwise, when ``shear_cell.youngs_modulus_per_stress``
-    (k) is positive, ``Y = k * normal_stress``, so that the stiffness number
-    ``(Y / sigma)^(2/3)``, which sets the contact overlaps relative to the particle size, is the
-    same at every pre-shear stress; otherwise ``material.youngsModulus``.
+    (k) is positive, ``Y = min(k * normal_stress, shear_cell.youngs_modulus_max)``, so that the
+    stiffness number ``(Y / sigma)^(2/3)``, which sets the contact overlaps relative to the
+    particle size, is the same at every pre-shear stress up to the cap; otherwise
+    ``material.youngsModulus``.
     """
     if "youngsModulus" in case:
         return float(case["youngsModulus"])
     ratio = float(_get(cell, "youngs_modulus_per_stress", "shear_cell"))
     if ratio > 0.0:
-        return ratio * float(case["normal_stress"])
+        cap = float(_get(cell, "youngs_modulus_max", "shear_cell"))
+        return min(ratio * float(case["normal_stress"]), cap)
     return float(_get(material, "youngsModulus", "material"))
 
 

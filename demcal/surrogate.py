@@ -105,6 +105,33 @@ def _scale(values: np.ndarray) -> np.ndarray:
     return np.where(scale > 0.0, scale, 1.0)
 
 
+def split_groups(
+    groups: Sequence[object], seed: int, fractions: Sequence[float] = (0.7, 0.15, 0.15)
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Random split that keeps all samples of a group in the same set.
+
+    Rows that share a DEM parameter set (e.g. the load conditions of one case, whose pre-shear
+    values coincide) must not be split between training and test, or the test set would
+    measure memory instead of prediction.
+
+    Parameters
+    ----------
+    groups : sequence, shape (n,)
+        Group label of every sample.
+    seed, fractions
+        As in :func:`split_indices`, applied to the distinct groups.
+
+    Returns
+    -------
+    train, val, test : numpy.ndarray of int64
+        Sorted sample indices.
+    """
+    labels = np.asarray(groups)
+    unique, inverse = np.unique(labels, return_inverse=True)
+    parts = split_indices(len(unique), seed, fractions)
+    return tuple(np.flatnonzero(np.isin(inverse, part)).astype(np.int64) for part in parts)
+
+
 class MLPSurrogate(RegressorMixin, BaseEstimator):
     """One-hidden-layer tanh network with a linear output, trained with early stopping.
 

@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from demcal.bulk_values import extract
+from demcal.cases import load_condition, shear_suffixes
 from demcal.decks import render_case
 from demcal.dem_run import run_deck
 
@@ -23,10 +24,9 @@ def simulate_reference(
     work_dir = Path(work_dir)
     frames = []
     cases: list[tuple[str, dict]] = [("angle_of_repose", {"case_id": "reference", **parameters})]
-    for k, stress in enumerate(config["shear_cell"]["normal_stresses"], start=1):
-        cases.append(
-            ("shear_cell", {"case_id": f"reference_s{k}", "normal_stress": stress, **parameters})
-        )
+    for suffix in shear_suffixes(config):
+        key = f"reference{suffix}"
+        cases.append(("shear_cell", {"case_id": key, **parameters, **load_condition(config, key)}))
     for test, case in cases:
         case_dir = work_dir / test / case["case_id"]
         info = render_case(test, case, config, case_dir)
@@ -45,7 +45,13 @@ def simulate_reference(
 
 
 def experiment_record(
-    bulk: pd.DataFrame, material: str, noise: float, seed: int, source: str
+    bulk: pd.DataFrame,
+    material: str,
+    noise: float,
+    seed: int,
+    source: str,
+    observables: tuple[str, ...] = ("mu_psh", "mu_sh", "rho_b"),
+    p_values: tuple[float, ...] | None = None,
 ) -> dict[str, Any]:
     """An experiment-file mapping from reference bulk values, with relative Gaussian noise.
 
@@ -55,6 +61,10 @@ def experiment_record(
         Output of :func:`simulate_reference`.
     noise : float
         Relative standard deviation of the measurement noise (e.g. 0.01), also written as sd.
+    observables : tuple of str
+        Shear-cell readings to keep (partial data, as a real test may give).
+    p_values : tuple of float, optional
+        Shear load fractions to keep; all when None.
     """
     rng = np.random.default_rng(seed)
 
@@ -68,12 +78,14 @@ def experiment_record(
         record["angle_of_repose"] = {"value": round(noisy(value), 4), "sd": round(noise * value, 4)}
     conditions = []
     shear = bulk[bulk["test"] == "shear_cell"]
+    if p_values is not None:
+        shear = shear[shear["P"].round(6).isin([round(p, 6) for p in p_values])]
     for _, row in shear.sort_values(["normal_stress", "P"]).iterrows():
         entry: dict[str, float] = {
             "normal_stress": float(row["normal_stress"]),
             "P": float(row["P"]),
         }
-        for name in ("mu_psh", "mu_sh", "rho_b"):
+        for name in observables:
             if np.isfinite(row[name]):
                 entry[name] = round(noisy(float(row[name])), 6)
                 entry[f"{name}_sd"] = round(noise * float(row[name]), 6)

@@ -11,7 +11,7 @@ import pandas as pd
 from demcal.baselines import bayesian_linear_regression, gaussian_process_regression
 from demcal.dataset import usable
 from demcal.regression_metrics import method_comparison_table, regression_metrics, to_markdown
-from demcal.surrogate import MLPSurrogate, SweepResult, split_indices, sweep_hidden_sizes
+from demcal.surrogate import MLPSurrogate, SweepResult, split_groups, sweep_hidden_sizes
 from demcal.surrogate_figures import parity_plot, r2_vs_hidden_size
 
 #: Candidate inputs per bulk value (paper section "Artificial Neural Networks").
@@ -74,7 +74,7 @@ def train_output(
     Raises
     ------
     ValueError
-        When fewer than 6 usable samples exist (no meaningful 70/15/15 split).
+        When fewer than 6 usable samples or 3 parameter sets exist (no meaningful split).
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -87,7 +87,8 @@ def train_output(
     X = rows[features].to_numpy(dtype=float)
     y = rows[output].to_numpy(dtype=float)
     seed = int(settings["seed"])
-    train, val, test = split_indices(len(rows), seed, tuple(settings["split"]))
+    # Split by parameter set: the load conditions of one set are not independent samples.
+    train, val, test = split_groups(rows["design_id"].to_numpy(), seed, tuple(settings["split"]))
     lo, hi = settings["hidden_sizes"]
     sweep = sweep_hidden_sizes(
         X,

@@ -22,6 +22,10 @@ def main() -> None:
     parser.add_argument("--out", required=True, help="experiment file to write")
     parser.add_argument("--noise", type=float, default=0.0, help="relative measurement noise")
     parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument(
+        "--observables", default="mu_psh,mu_sh,rho_b", help="shear-cell readings to keep"
+    )
+    parser.add_argument("--P", default=None, help="shear load fractions to keep, comma-separated")
     args = parser.parse_args()
     config = load_config(args.config)
     truth = yaml.safe_load(Path(args.truth).read_text())
@@ -34,6 +38,8 @@ def main() -> None:
         args.seed,
         f"dem_engine at the parameters of {Path(args.truth).name}, {args.config}, "
         f"noise {args.noise:.1%}",
+        observables=tuple(args.observables.split(",")),
+        p_values=tuple(float(p) for p in args.P.split(",")) if args.P else None,
     )
     Path(args.out).write_text(
         "# Synthetic measurements made by scripts/make_synthetic_experiment.py; the true\n"

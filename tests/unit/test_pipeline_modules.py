@@ -28,11 +28,17 @@ def config():
 def test_case_ids_and_rows(config):
     design = design_from_config(config)
     ids = case_ids(config, design, "shear_cell")
-    assert ids[:3] == ["c0001_s1", "c0001_s2", "c0001_s3"]
-    assert len(ids) == 3 * len(config["shear_cell"]["normal_stresses"])
+    assert ids[:3] == ["c0001_s1_p1", "c0001_s1_p2", "c0001_s1_p3"]
+    assert len(ids) == 3 * len(config["shear_cell"]["normal_stresses"]) * len(
+        config["shear_cell"]["P"]
+    )
+    cycles = dict(config, shear_cell=dict(config["shear_cell"], separate_runs=False))
+    assert case_ids(cycles, design, "shear_cell")[:2] == ["c0001_s1", "c0001_s2"]
+    assert case_row(cycles, design, "shear_cell", "c0001_s2")["normal_stress"] == 2029.0
     assert case_ids(config, design, "angle_of_repose") == ["c0001", "c0002", "c0003"]
-    row = case_row(config, design, "shear_cell", "c0002_s3")
+    row = case_row(config, design, "shear_cell", "c0002_s3_p2")
     assert row["normal_stress"] == config["shear_cell"]["normal_stresses"][2]
+    assert row["P"] == config["shear_cell"]["P"][1]
     assert row["coefficientFriction"] == pytest.approx(design.iloc[1]["coefficientFriction"])
     with pytest.raises(KeyError, match="c0009"):
         case_row(config, design, "angle_of_repose", "c0009")
@@ -40,9 +46,13 @@ def test_case_ids_and_rows(config):
 
 def test_verification_case_uses_identified_means(config):
     identified = {"parameters": {"coefficientFriction": {"mean": 0.5, "sd": 0.1}}}
-    row = verification_case(config, identified, "shear_cell", "identified_s2")
-    assert row == {"case_id": "identified_s2", "coefficientFriction": 0.5,
-                   "normal_stress": config["shear_cell"]["normal_stresses"][1]}
+    row = verification_case(config, identified, "shear_cell", "identified_s2_p4")
+    assert row == {
+        "case_id": "identified_s2_p4",
+        "coefficientFriction": 0.5,
+        "normal_stress": config["shear_cell"]["normal_stresses"][1],
+        "P": config["shear_cell"]["P"][3],
+    }
     with pytest.raises(ValueError, match="no parameter set"):
         verification_case(config, {"parameters": {}}, "angle_of_repose", "identified")
 
@@ -73,19 +83,33 @@ def test_run_deck_records_success_and_failure(tmp_path):
 def _case_dir(tmp_path, name, status, test="shear_cell"):
     d = tmp_path / name
     d.mkdir()
-    case = {"case_id": name, "coefficientFriction": 0.4, "coefficientRollingFriction": 0.3,
-            "coefficientRestitution": 0.6, "density": 2600.0, "normal_stress": 2029.0}
+    case = {
+        "case_id": name,
+        "coefficientFriction": 0.4,
+        "coefficientRollingFriction": 0.3,
+        "coefficientRestitution": 0.6,
+        "density": 2600.0,
+        "normal_stress": 2029.0,
+    }
     (d / "case.json").write_text(json.dumps({"case": case, "setup": {"dCylDp": 10}}))
-    (d / "status.json").write_text(json.dumps({"status": status, "error": "ERROR: boom",
-                                                "seconds": 1.5}))
+    (d / "status.json").write_text(
+        json.dumps({"status": status, "error": "ERROR: boom", "seconds": 1.5})
+    )
     return d
 
 
 def test_case_rows_ok_and_failed(tmp_path):
     def extract(test, case_dir):
-        return pd.DataFrame({"case_id": ["x"] * 2, "normal_stress": [2029.0] * 2,
-                             "P": [0.6, 1.0], "mu_psh": [0.6, 0.61], "mu_sh": [0.5, 0.6],
-                             "rho_b": [1700.0, 1701.0]})
+        return pd.DataFrame(
+            {
+                "case_id": ["x"] * 2,
+                "normal_stress": [2029.0] * 2,
+                "P": [0.6, 1.0],
+                "mu_psh": [0.6, 0.61],
+                "mu_sh": [0.5, 0.6],
+                "rho_b": [1700.0, 1701.0],
+            }
+        )
 
     ok = case_rows("shear_cell", _case_dir(tmp_path, "c0001_s2", "ok"), extract, [0.6, 1.0])
     bad = case_rows("shear_cell", _case_dir(tmp_path, "c0002_s2", "failed"), extract, [0.6, 1.0])
@@ -99,17 +123,26 @@ def test_case_rows_ok_and_failed(tmp_path):
 
 def test_load_experiment_partial_and_invalid(tmp_path):
     good = tmp_path / "m.yaml"
-    good.write_text(yaml.safe_dump({
-        "material": "m", "angle_of_repose": {"value": 35.0},
-        "shear_cell": [{"normal_stress": 1068, "P": 0.6, "mu_sh": 0.5},
-                       {"normal_stress": 2029, "P": 1.0}]}))
+    good.write_text(
+        yaml.safe_dump(
+            {
+                "material": "m",
+                "angle_of_repose": {"value": 35.0},
+                "shear_cell": [
+                    {"normal_stress": 1068, "P": 0.6, "mu_sh": 0.5},
+                    {"normal_stress": 2029, "P": 1.0},
+                ],
+            }
+        )
+    )
     exp = load_experiment(good)
     assert exp.angle_of_repose == 35.0
     assert len(exp.shear_conditions) == 1  # a condition without readings matches nothing
     assert exp.shear_conditions[0].values == {"mu_sh": 0.5}
     bad = tmp_path / "bad.yaml"
-    bad.write_text(yaml.safe_dump({"material": "m", "shear_cell": [{"normal_stress": 1,
-                                                                     "P": 2.0}]}))
+    bad.write_text(
+        yaml.safe_dump({"material": "m", "shear_cell": [{"normal_stress": 1, "P": 2.0}]})
+    )
     with pytest.raises(ConfigError, match=r"(?s)bad\.yaml.*shear_cell\.0\.P"):
         load_experiment(bad)
 
@@ -126,22 +159,53 @@ class Linear:
 
 
 def test_calibration_recovers_truth_with_analytic_surrogates():
-    features = ["coefficientFriction", "coefficientRollingFriction", "coefficientRestitution",
-                "density", "dCylDp", "normal_stress", "P"]
+    features = [
+        "coefficientFriction",
+        "coefficientRollingFriction",
+        "coefficientRestitution",
+        "density",
+        "dCylDp",
+        "normal_stress",
+        "P",
+    ]
     mu_psh = Linear([0.5, 0.2, 0.0, 0.0, 0.0, 0.0, 0.0], 0.2)
     rho_b = Linear([0.0, 0.0, 0.0, 0.6, 0.0, 0.0, 0.0], 0.0)
     aor = Linear([10.0, 30.0, 0.0, 0.0, 0.0], 10.0)
-    truth = {"coefficientFriction": 0.6, "coefficientRollingFriction": 0.4,
-             "coefficientRestitution": 0.7, "density": 3000.0}
-    exp = Experiment("m", "", [MeasuredCondition(
-        values={"mu_psh": 0.2 + 0.5 * 0.6 + 0.2 * 0.4, "rho_b": 0.6 * 3000.0},
-        normal_stress=2029.0, P=1.0)], angle_of_repose=10 + 6 + 12)
-    screening = {"axes": {"coefficientFriction": [0.1, 1.0, 60],
-                          "coefficientRollingFriction": [0.1, 1.0, 60],
-                          "coefficientRestitution": [0.5, 0.9, 3], "density": [2500, 3500, 25]},
-                 "seed": 1, "tolerance": 0.05, "chunk_size": 1024, "threads": 1}
-    surrogates = {"mu_psh": (mu_psh, features), "rho_b": (rho_b, features),
-                  "aor": (aor, features[:5])}
+    truth = {
+        "coefficientFriction": 0.6,
+        "coefficientRollingFriction": 0.4,
+        "coefficientRestitution": 0.7,
+        "density": 3000.0,
+    }
+    exp = Experiment(
+        "m",
+        "",
+        [
+            MeasuredCondition(
+                values={"mu_psh": 0.2 + 0.5 * 0.6 + 0.2 * 0.4, "rho_b": 0.6 * 3000.0},
+                normal_stress=2029.0,
+                P=1.0,
+            )
+        ],
+        angle_of_repose=10 + 6 + 12,
+    )
+    screening = {
+        "axes": {
+            "coefficientFriction": [0.1, 1.0, 60],
+            "coefficientRollingFriction": [0.1, 1.0, 60],
+            "coefficientRestitution": [0.5, 0.9, 3],
+            "density": [2500, 3500, 25],
+        },
+        "seed": 1,
+        "tolerance": 0.05,
+        "chunk_size": 1024,
+        "threads": 1,
+    }
+    surrogates = {
+        "mu_psh": (mu_psh, features),
+        "rho_b": (rho_b, features),
+        "aor": (aor, features[:5]),
+    }
     const = {k: {"dCylDp": 10.0} for k in surrogates}
     result = calibrate(surrogates, exp, screening, const)
     assert result.n_total == 60 * 60 * 3 * 25
@@ -159,8 +223,13 @@ def test_calibration_recovers_truth_with_analytic_surrogates():
 def test_calibration_names_unscreened_varying_input():
     model = Linear([1.0, 1.0], 0.0)
     exp = Experiment("m", "", [], angle_of_repose=1.0)
-    screening = {"axes": {"coefficientFriction": [0.1, 1.0, 3]}, "seed": 1, "tolerance": 0.05,
-                 "chunk_size": 1024, "threads": 1}
+    screening = {
+        "axes": {"coefficientFriction": [0.1, 1.0, 3]},
+        "seed": 1,
+        "tolerance": 0.05,
+        "chunk_size": 1024,
+        "threads": 1,
+    }
     with pytest.raises(ValueError, match="wallFriction"):
         calibrate({"aor": (model, ["coefficientFriction", "wallFriction"])}, exp, screening, {})
 
@@ -173,13 +242,25 @@ def test_constant_inputs_wrapper():
 
 
 def test_verification_table():
-    runs = pd.DataFrame({"test": ["shear_cell", "angle_of_repose"],
-                         "normal_stress": [2029.0, math.nan], "P": [1.0, math.nan],
-                         "rho_b": [1800.0, math.nan], "aor": [math.nan, 36.0]})
-    exp = Experiment("m", "", [MeasuredCondition(values={"rho_b": 1760.0},
-                                                 uncertainties={"rho_b": 42.0},
-                                                 normal_stress=2029.0, P=1.0)],
-                     angle_of_repose=38.85)
+    runs = pd.DataFrame(
+        {
+            "test": ["shear_cell", "angle_of_repose"],
+            "normal_stress": [2029.0, math.nan],
+            "P": [1.0, math.nan],
+            "rho_b": [1800.0, math.nan],
+            "aor": [math.nan, 36.0],
+        }
+    )
+    exp = Experiment(
+        "m",
+        "",
+        [
+            MeasuredCondition(
+                values={"rho_b": 1760.0}, uncertainties={"rho_b": 42.0}, normal_stress=2029.0, P=1.0
+            )
+        ],
+        angle_of_repose=38.85,
+    )
     table = verification_table(runs, exp, 0.05)
     assert list(table["observable"]) == ["rho_b", "aor"]
     assert table["relative_deviation"].iloc[0] == pytest.approx(40 / 1760)

@@ -126,6 +126,9 @@ def test_youngs_modulus_scales_with_stress_when_asked() -> None:
     assert shear_cell_youngs_modulus(CASE, cfg["material"], cfg["shear_cell"]) == 1e7
     cfg["shear_cell"]["youngs_modulus_per_stress"] = 1000.0
     assert shear_cell_youngs_modulus(CASE, cfg["material"], cfg["shear_cell"]) == 2.029e6
+    high = {**CASE, "normal_stress": 10070.0}
+    cfg["shear_cell"]["youngs_modulus_per_stress"] = 3000.0
+    assert shear_cell_youngs_modulus(high, cfg["material"], cfg["shear_cell"]) == 1e7
     own = {**CASE, "youngsModulus": 5e6}
     assert shear_cell_youngs_modulus(own, cfg["material"], cfg["shear_cell"]) == 5e6
 

@@ -273,3 +273,16 @@ def test_r2_vs_hidden_size_writes_png(tmp_path: Path) -> None:
     assert _is_png(out)
     with pytest.raises(KeyError, match="val_mse"):
         r2_vs_hidden_size(table.drop(columns="val_mse"), tmp_path / "bad.png")
+
+
+def test_split_groups_keeps_groups_together():
+    from demcal.surrogate import split_groups
+
+    groups = np.repeat([f"c{k:04d}" for k in range(20)], 4)  # 20 parameter sets x 4 loads
+    train, val, test = split_groups(groups, seed=3)
+    assert len(train) + len(val) + len(test) == 80
+    sets = [set(groups[idx]) for idx in (train, val, test)]
+    assert not (sets[0] & sets[1] or sets[0] & sets[2] or sets[1] & sets[2])
+    assert [len(s) for s in sets] == [14, 3, 3]
+    again = split_groups(groups, seed=3)
+    assert all(np.array_equal(a, b) for a, b in zip((train, val, test), again, strict=True))

@@ -1,5 +1,5 @@
 # Shared set-up: validated configuration, the case list and output locations.
-from demcal.cases import TESTS, case_ids, case_row, design_from_config
+from demcal.cases import TESTS, case_ids, case_row, design_from_config, verification_case_ids
 from demcal.config import validate_config
 
 validate_config(config, source=", ".join(str(f) for f in workflow.configfiles) or "config")
@@ -16,11 +16,7 @@ OUTPUTS_TRAINED = ["mu_psh", "mu_sh", "rho_b", "aor"]
 # workflow is parsed; wildcards carry these ids, never floats.
 DESIGN = design_from_config(config)
 CASES = {test: case_ids(config, DESIGN, test) for test in TESTS}
-N_STRESSES = len(config["shear_cell"]["normal_stresses"])
-VERIFICATION_CASES = {
-    "shear_cell": [f"identified_s{k + 1}" for k in range(N_STRESSES)],
-    "angle_of_repose": ["identified"],
-}
+VERIFICATION_CASES = {test: verification_case_ids(config, test) for test in TESTS}
 
 
 def resource(kind, key, default):

@@ -1,4 +1,10 @@
-# Stage 2: render one deck per DEM case and run it with the configured engine.
+# Stage 2: render one deck per DEM case, run it with the configured engine, extract its bulk
+# values.
+from pathlib import Path
+
+from demcal.dataset import write_case_rows
+from demcal.decks import render_case
+from demcal.rule_log import rule_log
 
 
 rule render_case:
@@ -9,11 +15,11 @@ rule render_case:
         f"{LOGS}/render/{{test}}/{{case}}.log",
     params:
         case=lambda wc: case_row(config, DESIGN, wc.test, wc.case),
-    conda:
-        CONDA_ENV
     localrule: True
-    script:
-        "../../scripts/render_case.py"
+    run:
+        # In-process: a new interpreter per case would cost more than the rendering.
+        with rule_log(log[0]):
+            render_case(wildcards.test, params.case, config, Path(output.deck).parent)
 
 
 rule run_case:
@@ -46,10 +52,7 @@ rule bulk_case:
         f"{LOGS}/bulk/{{stage}}/{{test}}/{{case}}.log",
     params:
         p_values=config["shear_cell"]["P"],
-    resources:
-        runtime=resource("analysis", "runtime", 10),
-        mem_mb=resource("analysis", "mem_mb", 1000),
-    conda:
-        CONDA_ENV
-    script:
-        "../../scripts/extract_bulk.py"
+    localrule: True
+    run:
+        with rule_log(log[0]):
+            write_case_rows(wildcards.test, Path(input.info).parent, params.p_values, output.bulk)

@@ -468,6 +468,8 @@ void Input::dispatch(const Command& command, bool text_quoted) {
     if (args.size() != 1) throw EngineError("expected 'label NAME'");
   } else if (name == "jump") {
     run_jump(command);
+  } else if (name == "if") {
+    run_if(command, text_quoted);
   } else if (name == "shell") {
     throw EngineError("shell commands are refused: a deck may not run programs on the host");
   } else {
@@ -509,6 +511,49 @@ void Input::run_print(const Command& command, bool text_quoted) {
     if (!out) throw EngineError("cannot open '" + path + "' for writing");
     out << text << '\n';
     if (!out) throw EngineError("cannot write to '" + path + "'");
+  }
+}
+
+// if "COND" then "CMD" ... [elif "COND" "CMD" ...] ... [else "CMD" ...] (LAMMPS semantics):
+// the first true branch runs its commands, each as a deck line at the `if` line, so that a
+// `jump SELF label` among them continues a loop in the current file.
+void Input::run_if(const Command& command, bool condition_quoted) {
+  const std::vector<std::string>& a = command.args;
+  if (a.size() < 3 || a[1] != "then") {
+    throw EngineError("expected 'if \"CONDITION\" then \"COMMAND\" ... [elif ...] [else ...]'");
+  }
+  auto holds = [&](const std::string& condition, bool quoted) {
+    const std::string text = quoted ? substitute(condition) : condition;
+    return evaluate_expression(text, variables_, handler_.eval_context()) != 0.0;
+  };
+  std::size_t i = 2;
+  bool taken = holds(a[0], condition_quoted);
+  bool done = false;
+  while (i < a.size()) {
+    std::vector<std::string> commands;
+    while (i < a.size() && a[i] != "elif" && a[i] != "else") commands.push_back(a[i++]);
+    if (commands.empty()) throw EngineError("if: a branch has no command");
+    if (taken && !done) {
+      for (const std::string& line : commands) execute_line(line, command.where);
+      done = true;
+    }
+    if (i >= a.size()) break;
+    if (a[i] == "else") {
+      ++i;
+      taken = true;
+      if (i >= a.size()) throw EngineError("if: 'else' has no command");
+      std::vector<std::string> rest(a.begin() + static_cast<long>(i), a.end());
+      for (const std::string& w : rest)
+        if (w == "elif" || w == "else") throw EngineError("if: nothing may follow the else branch");
+      if (!done)
+        for (const std::string& line : rest) execute_line(line, command.where);
+      return;
+    }
+    // elif: the condition word was not substituted on the line only if it was quoted; it is
+    // substituted here in either case (substitution of plain text is idempotent).
+    if (i + 1 >= a.size()) throw EngineError("if: 'elif' needs a condition and commands");
+    taken = !done && holds(a[i + 1], true);
+    i += 2;
   }
 }
 

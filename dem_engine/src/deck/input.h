@@ -22,8 +22,8 @@ class CommandHandler {
 };
 
 // Reads decks: comments, '&' continuation, quotes, variable substitution (${name}, $x, $(expr)),
-// and the built-in commands variable, next, print, include, log, echo, label, jump and shell
-// (refused). Every error leaves as a DeckError carrying the file and line of the command.
+// and the built-in commands variable, next, print, include, log, echo, label, jump, if and
+// shell (refused). Every error leaves as a DeckError carrying the file and line of the command.
 class Input {
  public:
   Input(CommandHandler& handler, Variables& variables);
@@ -38,6 +38,7 @@ class Input {
   struct FileReader;  // physical lines of one deck file and the read position (input.cpp)
   void run_reader(FileReader& reader);
   void execute_line(const std::string& line, const SourceLocation& where);
+  void run_if(const Command& command, bool condition_quoted);
   void dispatch(const Command& command, bool text_quoted);
   void run_print(const Command& command, bool text_quoted);
   void run_include(const Command& command);
