@@ -76,6 +76,7 @@ def main() -> None:
     )
     parser.add_argument("--steps", type=int, default=4000)
     args = parser.parse_args()
+    args.engine = str(Path(args.engine).resolve())  # the runs happen in temporary directories
     print(
         f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
         f"engine: {args.engine}"
