@@ -62,10 +62,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field, fields
+from functools import partial
 from typing import Any
 
 import numpy as np
 
+from demcal import config_values
 from demcal.shear_cell_setup import (
     GRAVITY,
     MaterialSetup,
@@ -98,36 +100,15 @@ APPLICATION_PARAMETERS = (
 
 _SECTION = "application"
 
+# Configuration access with errors naming application.<key>.
+_get = partial(config_values.required, where=_SECTION)
+_positive = partial(config_values.positive, where=_SECTION)
+_in_range = partial(config_values.in_range, where=_SECTION)
+_count = partial(config_values.count, where=_SECTION)
+
 
 # ----------------------------------------------------------------------------------------------
 # configuration access
-
-
-def _get(section: Mapping[str, Any], key: str) -> Any:
-    if key not in section:
-        raise KeyError(f"configuration: missing key '{_SECTION}.{key}'")
-    return section[key]
-
-
-def _positive(section: Mapping[str, Any], key: str) -> float:
-    x = float(_get(section, key))
-    if not (math.isfinite(x) and x > 0.0):
-        raise SetupError(f"configuration: '{_SECTION}.{key}' must be a positive number, got {x!r}")
-    return x
-
-
-def _in_range(section: Mapping[str, Any], key: str, lo: float, hi: float) -> float:
-    x = float(_get(section, key))
-    if not (math.isfinite(x) and lo <= x <= hi):
-        raise SetupError(f"configuration: '{_SECTION}.{key}' must lie in [{lo}, {hi}], got {x!r}")
-    return x
-
-
-def _count(section: Mapping[str, Any], key: str, minimum: int) -> int:
-    x = int(_get(section, key))
-    if x < minimum:
-        raise SetupError(f"configuration: '{_SECTION}.{key}' must be >= {minimum}, got {x}")
-    return x
 
 
 def application_parameters(

@@ -15,8 +15,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
+from functools import partial
 from typing import Any
 
+from demcal import config_values
 from demcal.shear_cell_setup import (
     GRAVITY,
     MaterialSetup,
@@ -27,6 +29,12 @@ from demcal.shear_cell_setup import (
 from demcal.size_distribution import SizeDistribution
 
 __all__ = ["ReposeSetup", "lift_froude_number", "repose_setup"]
+
+# Configuration access with errors naming angle_of_repose.<key>.
+_get = partial(config_values.required, where="angle_of_repose")
+_positive = partial(config_values.positive, where="angle_of_repose")
+_fraction = partial(config_values.fraction, where="angle_of_repose")
+_count = partial(config_values.count, where="angle_of_repose")
 
 
 @dataclass(frozen=True)
@@ -105,35 +113,6 @@ class ReposeSetup:
         out["box_lo"] = list(self.box_lo)
         out["box_hi"] = list(self.box_hi)
         return out
-
-
-def _get(section: Mapping[str, Any], key: str) -> Any:
-    if key not in section:
-        raise KeyError(f"configuration: missing key 'angle_of_repose.{key}'")
-    return section[key]
-
-
-def _positive(section: Mapping[str, Any], key: str) -> float:
-    x = float(_get(section, key))
-    if not (math.isfinite(x) and x > 0.0):
-        raise SetupError(
-            f"configuration: 'angle_of_repose.{key}' must be a positive number, got {x!r}"
-        )
-    return x
-
-
-def _fraction(section: Mapping[str, Any], key: str) -> float:
-    x = float(_get(section, key))
-    if not (math.isfinite(x) and 0.0 < x <= 1.0):
-        raise SetupError(f"configuration: 'angle_of_repose.{key}' must lie in (0, 1], got {x!r}")
-    return x
-
-
-def _count(section: Mapping[str, Any], key: str, minimum: int) -> int:
-    x = int(_get(section, key))
-    if x < minimum:
-        raise SetupError(f"configuration: 'angle_of_repose.{key}' must be >= {minimum}, got {x}")
-    return x
 
 
 def lift_froude_number(lift_speed: float, diameter: float) -> float:

@@ -49,6 +49,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from demcal import config_values
+from demcal.config_values import SetupError
 from demcal.size_distribution import SizeDistribution, monodisperse, sinter_fines
 
 __all__ = [
@@ -73,25 +75,12 @@ __all__ = [
 GRAVITY = 9.81
 
 
-class SetupError(ValueError):
-    """A setting makes the set-up impossible; the message names the configuration key."""
-
-
 # ----------------------------------------------------------------------------------------------
 # shared helpers: particles, material, time step, seeds
 
-
-def _get(section: Mapping[str, Any], key: str, where: str) -> Any:
-    if key not in section:
-        raise KeyError(f"configuration: missing key '{where}.{key}'")
-    return section[key]
-
-
-def _positive(value: Any, where: str) -> float:
-    x = float(value)
-    if not (math.isfinite(x) and x > 0.0):
-        raise SetupError(f"configuration: '{where}' must be a positive number, got {value!r}")
-    return x
+_get = config_values.required
+_positive = config_values.positive_value
+_fraction = config_values.fraction_value
 
 
 def size_distribution(particles: Mapping[str, Any]) -> SizeDistribution:
@@ -583,13 +572,6 @@ class ShearCellSetup:
         for seg in out["segments"]:
             seg["ctrl"] = list(seg["ctrl"])
         return out
-
-
-def _fraction(value: Any, where: str, low: float = 0.0, high: float = 1.0) -> float:
-    x = float(value)
-    if not (math.isfinite(x) and low < x <= high):
-        raise SetupError(f"configuration: '{where}' must lie in ({low:g}, {high:g}], got {value!r}")
-    return x
 
 
 def _p_values(values: Sequence[Any]) -> list[float]:

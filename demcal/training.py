@@ -9,23 +9,13 @@ from typing import Any
 import pandas as pd
 
 from demcal.baselines import bayesian_linear_regression, gaussian_process_regression
-from demcal.dataset import usable
+from demcal.dataset import PARAMETERS, usable
 from demcal.regression_metrics import method_comparison_table, regression_metrics, to_markdown
 from demcal.surrogate import MLPSurrogate, SweepResult, split_groups, sweep_hidden_sizes
 from demcal.surrogate_figures import parity_plot, r2_vs_hidden_size
 
 #: Candidate inputs per bulk value (paper section "Artificial Neural Networks").
-SHEAR_INPUTS = (
-    "coefficientFriction",
-    "coefficientRollingFriction",
-    "coefficientRestitution",
-    "density",
-    "cohesionEnergyDensity",
-    "wallFriction",
-    "dCylDp",
-    "normal_stress",
-    "P",
-)
+SHEAR_INPUTS = (*PARAMETERS, "normal_stress", "P")
 REPOSE_INPUTS = SHEAR_INPUTS[:-2]
 INPUTS = {
     "mu_psh": SHEAR_INPUTS,
