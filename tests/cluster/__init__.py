@@ -1,0 +1,1 @@
+"""Workflow runs through real schedulers (a one-node Slurm cluster on localhost)."""
