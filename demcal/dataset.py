@@ -2,12 +2,15 @@
 
 import json
 import math
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
 from demcal.bulk_values import extract
+from demcal.provenance import write_sidecar
+from demcal.rule_log import rule_log
 
 #: Contact and geometry parameters a case may carry (LIGGGHTS names).
 PARAMETERS = (
@@ -97,6 +100,17 @@ def usable(data: pd.DataFrame, output: str) -> pd.DataFrame:
     return data[ok]
 
 
-def write_case_rows(test: str, case_dir: str | Path, p_values: Sequence[float], path: str) -> None:
-    """Extract the bulk rows of one case (see :func:`case_rows`) and write them as CSV."""
-    case_rows(test, case_dir, extract, p_values).to_csv(path, index=False, float_format="%.10g")
+def write_case_rows(
+    test: str,
+    info: str | Path,
+    p_values: Sequence[float],
+    path: str,
+    config: Mapping[str, Any],
+    log: str,
+) -> None:
+    """Extract the bulk rows of one case (directory of ``info``, see :func:`case_rows`) and
+    write them as CSV with a provenance sidecar (``<path>.json``); logs to ``log``."""
+    with rule_log(log):
+        rows = case_rows(test, Path(info).parent, extract, p_values)
+        rows.to_csv(path, index=False, float_format="%.10g")
+        write_sidecar(path, config, seed=int(config["seed"]), extra={"rows": len(rows)})

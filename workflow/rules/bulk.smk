@@ -8,7 +8,11 @@ rule collect_dataset:
         ],
     output:
         dataset=report(DATASET, category="Bulk values", caption="../report/dataset.rst"),
-        failed=f"{RESULTS}/bulk/failed_cases.csv",
+        failed=report(
+            f"{RESULTS}/bulk/failed_cases.csv",
+            category="Bulk values",
+            caption="../report/failed_cases.rst",
+        ),
     log:
         f"{LOGS}/bulk/collect_dataset.log",
     resources:

@@ -54,5 +54,4 @@ rule bulk_case:
         p_values=config["shear_cell"]["P"],
     localrule: True
     run:
-        with rule_log(log[0]):
-            write_case_rows(wildcards.test, Path(input.info).parent, params.p_values, output.bulk)
+        write_case_rows(wildcards.test, input.info, params.p_values, output.bulk, config, log[0])
