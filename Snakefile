@@ -24,6 +24,7 @@ include: "workflow/rules/bulk.smk"
 include: "workflow/rules/surrogate.smk"
 include: "workflow/rules/identify.smk"
 include: "workflow/rules/application.smk"
+include: "workflow/rules/discrepancy.smk"
 
 
 rule all:

@@ -1,0 +1,176 @@
+"""Find step of the discrepancy workflow on analytic surrogates with a known truth."""
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from demcal.acceptance import MeasuredCondition
+from demcal.discrepancy import (
+    ParameterBox,
+    SurrogateModel,
+    describe_disagreement,
+    find,
+    format_stress,
+    minimise_chi2,
+    observation_table,
+)
+from demcal.experiments import Experiment
+
+FEATURES = ["coefficientFriction", "density", "normal_stress", "P"]
+STRESSES = (1068.0, 2029.0, 10070.0)
+
+
+class Analytic:
+    """A surrogate given by a formula of its input matrix."""
+
+    def __init__(self, formula):
+        self.formula = formula
+        self.calls = 0
+
+    def predict(self, X):
+        self.calls += 1
+        return self.formula(np.asarray(X, dtype=float))
+
+
+def mu_psh(X):
+    return 0.2 + 0.6 * X[:, 0]
+
+
+def rho_b(X):
+    return X[:, 1] * (0.62 - 0.08 * X[:, 0])
+
+
+SURROGATES = {"mu_psh": (Analytic(mu_psh), FEATURES), "rho_b": (Analytic(rho_b), FEATURES)}
+BOX = ParameterBox({"coefficientFriction": (0.1, 1.0), "density": (2500.0, 3500.0)})
+
+
+def experiment(mu: float, density: float, extra=lambda name, stress: 0.0) -> Experiment:
+    """Measurements of the analytic material, plus ``extra(observable, stress)``."""
+    conds = []
+    for stress in STRESSES:
+        for p in (0.5, 1.0):
+            values = {
+                "mu_psh": 0.2 + 0.6 * mu + extra("mu_psh", stress),
+                "rho_b": density * (0.62 - 0.08 * mu) + extra("rho_b", stress),
+            }
+            conds.append(MeasuredCondition(values, {"mu_psh": 0.01, "rho_b": 8.0}, stress, p))
+    return Experiment("analytic", "test", conds)
+
+
+def model_for(exp: Experiment) -> SurrogateModel:
+    obs = observation_table(exp, {"mu_psh": 0.005, "rho_b": 4.0}, 0.05)
+    return SurrogateModel(SURROGATES, obs, BOX.names)
+
+
+def test_observation_table_combines_uncertainties():
+    conds = [MeasuredCondition({"mu_psh": 0.6, "rho_b": 1700.0}, {"rho_b": 30.0}, 1068.0, 1.0)]
+    exp = Experiment("m", "", conds, angle_of_repose=38.0, angle_of_repose_sd=1.5)
+    obs = observation_table(exp, {"mu_psh": 0.04, "rho_b": 40.0, "aor": 2.0}, 0.05)
+    assert list(obs["observable"]) == ["mu_psh", "rho_b", "aor"]
+    # No sd for mu_psh: tolerance * value = 0.03, combined with the RMSE 0.04 -> 0.05.
+    assert obs["sigma"].iloc[0] == pytest.approx(0.05)
+    assert obs["sigma"].iloc[1] == pytest.approx(50.0)
+    assert obs["sigma"].iloc[2] == pytest.approx(2.5)
+    assert math.isnan(obs["normal_stress"].iloc[2])
+
+
+def test_observation_table_needs_a_surrogate_per_measured_value():
+    conds = [MeasuredCondition({"mu_sh": 0.6}, {}, 1068.0, 1.0)]
+    with pytest.raises(KeyError, match="mu_sh"):
+        observation_table(Experiment("m", "", conds), {"mu_psh": 0.04}, 0.05, ["mu_sh"])
+
+
+def test_parameter_box_grid_and_integer_axes():
+    box = ParameterBox({"a": (0.0, 1.0), "n": (1.0, 3.0)}, frozenset({"n"}))
+    axes = box.axes(5)
+    assert list(axes["n"]) == [1.0, 2.0, 3.0]
+    grid = box.grid(5)
+    assert grid.shape == (15, 2)
+    assert set(map(tuple, grid)) == {(a, n) for a in axes["a"] for n in axes["n"]}
+    with pytest.raises(ValueError, match="low <= high"):
+        ParameterBox({"a": (1.0, 0.0)})
+
+
+def test_surrogate_model_names_an_unknown_input():
+    exp = experiment(0.4, 3000.0)
+    obs = observation_table(exp, {"mu_psh": 0.005, "rho_b": 4.0}, 0.05)
+    with pytest.raises(KeyError, match="density"):
+        SurrogateModel(SURROGATES, obs, ["coefficientFriction"])
+
+
+def test_minimise_chi2_refines_a_quadratic_to_its_minimum():
+    box = ParameterBox({"x": (0.0, 1.0), "y": (-2.0, 2.0)})
+    grid = box.grid(6)
+
+    def objective(theta):
+        return (theta[:, 0] - 0.3141) ** 2 + 4.0 * (theta[:, 1] - 0.777) ** 2 + 1.5
+
+    theta, value = minimise_chi2(objective, box, grid, objective(grid))
+    assert theta == pytest.approx([0.3141, 0.777], abs=1e-4)
+    assert value == pytest.approx(1.5, abs=1e-7)
+
+
+def test_find_recovers_the_truth_and_says_nothing_is_missing():
+    result = find(model_for(experiment(0.37, 2890.0)), BOX, 31, gap_threshold=1.5)
+    assert result.best.theta["coefficientFriction"] == pytest.approx(0.37, abs=1e-3)
+    assert result.best.theta["density"] == pytest.approx(2890.0, abs=2.0)
+    assert result.gap < 0.05
+    assert not result.missing and "nothing missing" in result.verdict
+    assert all(" fits at " in s for s in result.sentences)
+
+
+def test_find_matches_brute_force_over_the_grid():
+    exp = experiment(0.5, 3000.0, lambda name, s: 0.1 * 1068.0 / s if name == "mu_psh" else 0.0)
+    model = model_for(exp)
+    result = find(model, BOX, 21, gap_threshold=1.5, refine=False)
+    grid = BOX.grid(21)
+    y = model.observations["measured"].to_numpy()
+    sigma = model.observations["sigma"].to_numpy()
+    chi2 = np.array([np.sum(((model.predict(t[None])[0] - y) / sigma) ** 2) for t in grid])
+    assert result.best.deviance == pytest.approx(chi2.min())
+    assert result.gap == pytest.approx(math.sqrt(chi2.min() / len(y)))
+    z = (model.predict(grid) - y) / sigma
+    assert np.allclose(result.observations["best_abs_z"], np.abs(z).min(axis=0))
+
+
+def test_find_reports_unreachable_measurements_with_percentage():
+    # mu_psh at 1068 Pa is 1.1, the model reaches at most 0.8 (mu_s = 1): 37.5 % above.
+    exp = experiment(
+        0.5, 3000.0, lambda name, s: 0.6 if (name == "mu_psh" and s == 1068.0) else 0.0
+    )
+    result = find(model_for(exp), BOX, 21, gap_threshold=1.5)
+    assert result.missing
+    sentence = next(s for s in result.sentences if s.startswith("mu_psh"))
+    assert "at 1 068 Pa (P = 0.5, 1) is 38 % above anything the model reaches" in sentence
+    # The joint fit is pulled towards the unreachable values, away from the other stresses.
+    assert "2 029 Pa (P = 0.5, 1); 10 070 Pa (P = 0.5, 1) is reachable alone" in sentence
+    assert "sigma above it" in sentence
+    row = result.observations.iloc[0]
+    assert row["reach_max"] == pytest.approx(0.8)
+
+
+def test_describe_disagreement_conflict_direction():
+    obs = pd.DataFrame(
+        {
+            "observable": ["rho_b", "rho_b"],
+            "normal_stress": [1068.0, 2029.0],
+            "P": [1.0, 1.0],
+            "measured": [1750.0, 1620.0],
+            "sigma": [10.0, 10.0],
+            "reach_min": [1300.0, 1300.0],
+            "reach_max": [2100.0, 2100.0],
+            "z_at_best": [-4.0, 3.0],
+        }
+    )
+    (sentence,) = describe_disagreement(obs)
+    assert "rho_b at 1 068 Pa (P = 1) is reachable alone, but the best joint fit stays 4.0 " in (
+        sentence
+    )
+    assert "sigma below it" in sentence and "3.0 sigma above it" in sentence
+
+
+def test_format_stress_groups_thousands():
+    assert format_stress(10070.0) == "10 070 Pa"
+    assert format_stress(1068.4) == "1 068 Pa"

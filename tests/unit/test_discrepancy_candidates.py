@@ -1,0 +1,164 @@
+"""The candidate catalogue, its applicability and the cases of the discrepancy workflow."""
+
+import copy
+from pathlib import Path
+
+import pytest
+
+from demcal.acceptance import MeasuredCondition
+from demcal.config import load_config
+from demcal.discrepancy_candidates import (
+    applicability,
+    base_point,
+    candidate_config,
+    case_setup,
+    deep_merge,
+    extended_design,
+    parse_candidates,
+    probe_runs,
+    run_suffixes,
+)
+from demcal.discrepancy_plan import DiscrepancyPlan
+from demcal.discrepancy_synthetic import study_config
+from demcal.experiments import Experiment
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def quick():
+    """The default configuration: rolling friction on, sinter-fines sizes."""
+    return load_config(ROOT / "config" / "config.yaml")
+
+
+@pytest.fixture(scope="module")
+def study(quick):
+    """A model without rolling friction and cohesion, one size, mu_s and density varied."""
+    raw = {k: copy.deepcopy(v) for k, v in quick.items()}
+    config = study_config(raw, "quick")
+    return config
+
+
+def by_name(config):
+    return {c.name: c for c in parse_candidates(config["discrepancy"]["candidates"])}
+
+
+def test_default_catalogue_has_the_three_required_effects(quick):
+    names = set(by_name(quick))
+    assert {"cohesion", "rolling", "polydispersity"} <= names
+
+
+def test_applicability_follows_the_current_model(quick, study):
+    cands = by_name(quick)
+    # Default model: rolling friction on and varied, sinter-fines sizes with 4 classes.
+    assert applicability(cands["rolling"], quick)[0] is False
+    assert applicability(cands["polydispersity"], quick)[0] is False
+    assert applicability(cands["cohesion"], quick)[0] is True
+    assert applicability(cands["wallfriction"], quick)[0] is True
+    # The study model lacks rolling resistance and size spread.
+    assert applicability(cands["rolling"], study)[0] is True
+    assert applicability(cands["polydispersity"], study)[0] is True
+    with_cohesion = deep_merge(study, {"design": {"fixed": {"cohesionEnergyDensity": 100.0}}})
+    ok, reason = applicability(cands["cohesion"], with_cohesion)
+    assert not ok and "cohesionEnergyDensity = 100" in reason
+
+
+def test_parse_candidates_rejects_bad_entries():
+    good = {
+        "name": "cohesion",
+        "description": "d",
+        "parameter": "cohesionEnergyDensity",
+        "off_value": 0.0,
+        "range": [0.0, 1.0],
+        "probe_levels": [0.5],
+    }
+    with pytest.raises(ValueError, match="outside the range"):
+        parse_candidates([{**good, "probe_levels": [2.0]}])
+    with pytest.raises(ValueError, match="duplicate"):
+        parse_candidates([good, good])
+    with pytest.raises(ValueError, match="lower-case"):
+        parse_candidates([{**good, "name": "Wall_Friction"}])
+    with pytest.raises(KeyError, match=r"candidates\[0\]: missing key 'range'"):
+        parse_candidates([{k: v for k, v in good.items() if k != "range"}])
+    with pytest.raises(ValueError, match="whole"):
+        parse_candidates([{**good, "integer": True}])
+
+
+def test_candidate_config_switches_and_sets_config_keys(study):
+    cands = by_name(study)
+    rolling = candidate_config(study, cands["rolling"], 0.3)
+    assert rolling["material"]["rolling_friction"] is True
+    assert study["material"]["rolling_friction"] is False
+    poly = candidate_config(study, cands["polydispersity"], 3.0)
+    assert poly["particles"]["distribution"] == "sinter_fines"
+    assert poly["particles"]["classes"] == 3
+
+
+def test_case_setup_rows_and_loads(study):
+    cands = by_name(study)
+    point = base_point({"coefficientFriction": 0.4, "density": 2800.0}, study)
+    assert point["coefficientRestitution"] == 0.7 and point["coefficientRollingFriction"] == 0.0
+    row, cfg = case_setup("shear_cell", "cohesion2_s2_p1", point, study, cands["cohesion"], 4e4)
+    assert row["normal_stress"] == study["shear_cell"]["normal_stresses"][1]
+    assert row["P"] == study["shear_cell"]["P"][0]
+    assert row["cohesionEnergyDensity"] == 4e4 and row["discrepancy_candidate"] == "cohesion"
+    assert cfg == study
+    row, _ = case_setup("angle_of_repose", "ref", point, study)
+    assert "normal_stress" not in row and row["discrepancy_candidate"] == "none"
+    with pytest.raises(KeyError, match="no normal stress number 9"):
+        case_setup("shear_cell", "ref_s9_p1", point, study)
+
+
+def test_run_suffixes_keep_the_measured_conditions(study):
+    conds = [
+        MeasuredCondition({"rho_b": 1700.0}, {}, 2029.0, 0.5),
+        MeasuredCondition({"rho_b": 1700.0}, {}, 99.0, 0.5),
+    ]
+    # Study model: stresses 1068, 2029, 10070 Pa, P = 0.5, one run per condition.
+    assert run_suffixes(study, Experiment("m", "", conds)) == ["_s2_p1"]
+    cycles = deep_merge(study, {"shear_cell": {"separate_runs": False}})
+    assert run_suffixes(cycles, Experiment("m", "", conds)) == ["_s2"]
+
+
+def test_base_point_needs_every_contact_parameter(study):
+    broken = deep_merge(study, {})
+    broken["design"]["fixed"] = {}
+    with pytest.raises(KeyError, match="coefficientRollingFriction"):
+        base_point({}, broken)
+
+
+def test_extended_design_adds_the_effect_axis(study):
+    cands = by_name(study)
+    table = extended_design(study, cands["polydispersity"], 9, 5)
+    assert list(table["case_id"]) == [f"e{k:04d}" for k in range(1, 10)]
+    assert set(table["sizeClasses"]) <= set(range(1, 7)) and table["sizeClasses"].nunique() > 2
+    assert table["coefficientFriction"].between(0.1, 0.9).all()
+    assert (table["coefficientRestitution"] == 0.7).all()
+    cohesion = extended_design(study, cands["cohesion"], 4, 5)
+    # A Latin hypercube: one case per quarter of the cohesion range.
+    lo, hi = cands["cohesion"].range
+    quarters = sorted(((cohesion["cohesionEnergyDensity"] - lo) // ((hi - lo) / 4)).astype(int))
+    assert quarters == [0, 1, 2, 3]
+
+
+def test_probe_runs_and_plan_file_lists(study, tmp_path):
+    cands = [c for c in parse_candidates(study["discrepancy"]["candidates"])]
+    runs = probe_runs(cands[:2])
+    assert [r.case for r in runs][:3] == ["ref", "cohesion1", "cohesion2"]
+    plan = DiscrepancyPlan("results/discrepancy", ["shear_cell"], ["_s1", "_s2"], [], cands[:1])
+    assert plan.case_ids(["ref"]) == [("shear_cell", "ref_s1"), ("shear_cell", "ref_s2")]
+    find = tmp_path / "find.json"
+    find.write_text('{"missing": false}')
+    assert plan.probe_bulk(find) == []
+    find.write_text('{"missing": true}')
+    assert plan.probe_bulk(find) == [
+        f"results/discrepancy/probes/shear_cell/{c}_s{k}/bulk.csv"
+        for c in ("ref", "cohesion1", "cohesion2")
+        for k in (1, 2)
+    ]
+    ranking = tmp_path / "ranking.json"
+    ranking.write_text('{"winner": null}')
+    assert plan.show_inputs(find, ranking) == {"reference": plan.bulk_files("probes", ["ref"])}
+    ranking.write_text('{"winner": "cohesion"}')
+    inputs = plan.show_inputs(find, ranking)
+    assert inputs["verification"] == plan.bulk_files("verification", ["verify"])

@@ -1,0 +1,186 @@
+"""Name step: responses, candidate fits and the BIC ranking on synthetic data with a known truth."""
+
+import math
+
+import numpy as np
+import pytest
+
+from demcal.acceptance import MeasuredCondition
+from demcal.discrepancy import ParameterBox, SurrogateModel, find, observation_table
+from demcal.discrepancy_ranking import (
+    EffectResponse,
+    fit_candidate,
+    null_fit,
+    rank_candidates,
+    ranking_sigma,
+    response_signature,
+)
+from demcal.experiments import Experiment
+
+FEATURES = ["coefficientFriction", "density", "normal_stress", "P"]
+STRESSES = (1068.0, 2029.0, 10070.0)
+BOX = ParameterBox({"coefficientFriction": (0.1, 1.0), "density": (2500.0, 3500.0)})
+
+
+class Analytic:
+    def __init__(self, formula):
+        self.formula = formula
+
+    def predict(self, X):
+        return self.formula(np.asarray(X, dtype=float))
+
+
+SURROGATES = {
+    "mu_psh": (Analytic(lambda X: 0.2 + 0.6 * X[:, 0]), FEATURES),
+    "rho_b": (Analytic(lambda X: X[:, 1] * (0.62 - 0.08 * X[:, 0])), FEATURES),
+}
+
+
+def cohesion_effect(name: str, stress: float) -> float:
+    """A cohesion-like effect per unit magnitude: strongest at low stress."""
+    return (0.1 if name == "mu_psh" else 80.0) * 1068.0 / stress
+
+
+def uniform_effect(name: str, stress: float) -> float:
+    """An effect the current model can mimic (a shift absorbed by the parameters)."""
+    return 0.08 if name == "mu_psh" else -40.0
+
+
+def setup(magnitude: float):
+    """Model, grid and predictions for data with a cohesion-like effect of ``magnitude``."""
+    conds = []
+    for stress in STRESSES:
+        for p in (0.5, 1.0):
+            values = {
+                "mu_psh": 0.2 + 0.6 * 0.45 + magnitude * cohesion_effect("mu_psh", stress),
+                "rho_b": 2900.0 * (0.62 - 0.08 * 0.45)
+                + magnitude * cohesion_effect("rho_b", stress),
+            }
+            conds.append(MeasuredCondition(values, {"mu_psh": 0.01, "rho_b": 8.0}, stress, p))
+    obs = observation_table(Experiment("m", "", conds), {"mu_psh": 0.005, "rho_b": 4.0}, 0.05)
+    model = SurrogateModel(SURROGATES, obs, BOX.names)
+    grid = BOX.grid(31)
+    return model, grid, model.predict(grid)
+
+
+def response_of(effect, model: SurrogateModel, levels=(1.0, 2.0), name="x") -> EffectResponse:
+    """Exact 'DEM' response: linear in the magnitude."""
+    obs = model.observations
+    unit = np.array([effect(r.observable, r.normal_stress) for r in obs.itertuples()])
+    base = np.full(len(obs), 1.0)
+    values = np.vstack([base] + [base + level * unit for level in levels])
+    return EffectResponse.from_runs(name, [0.0, *levels], values, reference=0)
+
+
+def test_response_interpolates_between_levels():
+    resp = EffectResponse.from_runs(
+        "c", [4.0, 0.0, 2.0], np.array([[5.0, 1.0], [1.0, 1.0], [2.0, 3.0]]), reference=1
+    )
+    assert list(resp.magnitudes) == [0.0, 2.0, 4.0]
+    assert resp.reference == 0 and resp.off == 0.0
+    assert resp.at(0.0) == pytest.approx([0.0, 0.0])
+    assert resp.at(2.0) == pytest.approx([1.0, 2.0])
+    assert resp.at(3.0) == pytest.approx([2.5, 1.0])
+    # Beyond the probed span the response is held at the end value.
+    assert resp.at(9.0) == pytest.approx([4.0, 0.0])
+
+
+def test_response_drops_levels_equal_to_the_reference():
+    resp = EffectResponse.from_runs(
+        "w", [0.5, 0.5, 0.8], np.array([[1.0], [9.0], [2.0]]), reference=0
+    )
+    assert list(resp.magnitudes) == [0.5, 0.8]
+    assert resp.at(0.8) == pytest.approx([1.0])
+
+
+def test_integer_candidate_tries_whole_magnitudes():
+    resp = EffectResponse.from_runs(
+        "p", [1.0, 3.0], np.array([[0.0], [1.0]]), reference=0, integer=True
+    )
+    assert list(resp.trial_magnitudes(41)) == [1.0, 2.0, 3.0]
+
+
+def test_fit_recovers_the_hidden_magnitude():
+    model, grid, F = setup(magnitude=1.4)
+    weights = model.observations["sigma"].to_numpy()
+    fit = fit_candidate(model, BOX, grid, F, response_of(cohesion_effect, model), weights)
+    assert fit.magnitude == pytest.approx(1.4, abs=0.06)
+    assert fit.best.theta["coefficientFriction"] == pytest.approx(0.45, abs=0.01)
+    assert fit.best.deviance < 1.0
+
+
+def test_ranking_names_the_effect_that_explains_the_gap():
+    model, grid, F = setup(magnitude=1.0)
+    noise = model.observations["surrogate_rmse"].to_numpy()
+    weights = ranking_sigma(model.observations["sigma"].to_numpy(), noise)
+    null = null_fit(model, BOX, grid, F, weights)
+    fits = {
+        name: fit_candidate(model, BOX, grid, F, response_of(effect, model, name=name), weights)
+        for name, effect in (("cohesion", cohesion_effect), ("uniform", uniform_effect))
+    }
+    table, winner = rank_candidates(null.deviance, fits, len(model.observations), 6.0, 0.5)
+    assert winner == "cohesion"
+    top = table.iloc[0]
+    assert top["candidate"] == "cohesion" and top["rank"] == 1 and top["named"]
+    n = len(model.observations)
+    assert top["delta_bic"] == pytest.approx(null.deviance - top["deviance"] - math.log(n))
+    assert top["explained"] > 0.9
+    uniform = table.set_index("candidate").loc["uniform"]
+    assert uniform["explained"] < 0.5 and not uniform["named"]
+
+
+def test_ranking_names_nothing_without_an_effect():
+    model, grid, F = setup(magnitude=0.0)
+    weights = model.observations["sigma"].to_numpy()
+    null = null_fit(model, BOX, grid, F, weights)
+    assert null.deviance < 1e-3
+    resp = response_of(cohesion_effect, model)
+    fits = {"cohesion": fit_candidate(model, BOX, grid, F, resp, weights)}
+    table, winner = rank_candidates(null.deviance, fits, len(model.observations), 6.0)
+    assert winner is None
+    n = len(model.observations)
+    assert table["delta_bic"].iloc[0] == pytest.approx(-math.log(n), abs=1e-3)
+
+
+def test_ranking_requires_a_share_of_the_misfit():
+    model, grid, F = setup(magnitude=1.0)
+    weights = model.observations["sigma"].to_numpy()
+    null = null_fit(model, BOX, grid, F, weights)
+    # Explains the friction part of the hidden effect, not the density part.
+    resp = response_of(lambda name, s: cohesion_effect(name, s) * (name == "mu_psh"), model)
+    fits = {"partial": fit_candidate(model, BOX, grid, F, resp, weights)}
+    n = len(model.observations)
+    table, _ = rank_candidates(null.deviance, fits, n, -math.inf, 0.0)
+    share = float(table["explained"].iloc[0])
+    assert 0.0 < share < 1.0
+    _, named_low = rank_candidates(null.deviance, fits, n, -math.inf, share - 1e-9)
+    _, named_high = rank_candidates(null.deviance, fits, n, -math.inf, share + 1e-3)
+    assert named_low == "partial" and named_high is None
+
+
+def test_null_fit_with_find_weights_equals_find():
+    model, grid, F = setup(magnitude=1.0)
+    weights = model.observations["sigma"].to_numpy()
+    result = find(model, BOX, 31, gap_threshold=1.5)
+    assert null_fit(model, BOX, grid, F, weights).deviance == pytest.approx(
+        result.best.deviance, rel=1e-6
+    )
+
+
+def test_signature_of_a_cohesion_like_response():
+    model, _, _ = setup(magnitude=0.0)
+    resp = response_of(cohesion_effect, model, levels=(1.0,))
+    ref = np.where(model.observations["observable"] == "rho_b", 1700.0, 0.6)
+    noise = np.where(model.observations["observable"] == "rho_b", 4.0, 0.005)
+    text = response_signature(model.observations, resp, ref, noise)
+    assert "mu_psh +0.10 at 1 068 Pa, +0.05 at 2 029 Pa, +0.01 at 10 070 Pa" in text
+    assert "apparent friction falls with normal stress" in text
+    assert "rho_b +4.7 % at 1 068 Pa" in text
+
+
+def test_signature_ignores_responses_within_the_noise():
+    model, _, _ = setup(magnitude=0.0)
+    resp = response_of(uniform_effect, model, levels=(0.01,))
+    noise = np.where(model.observations["observable"] == "rho_b", 4.0, 0.005)
+    text = response_signature(model.observations, resp, np.full(len(noise), 1.0), noise)
+    assert text == "mu_psh no clear change; rho_b no clear change"
