@@ -7,8 +7,9 @@ parameter set theta is
     z_k(theta) = (f_k(theta) - y_k) / sigma_k,   sigma_k = sqrt(sd_k^2 + rmse_k^2),
 
 with f_k the surrogate of the observable at the load of k, y_k the measurement, sd_k its
-standard deviation (``tolerance * |y_k|`` when none is given) and rmse_k the test RMSE of the
-surrogate, so that a surrogate's own error is never mistaken for missing physics.
+standard deviation (``tolerance * |y_k|`` when none is given) and rmse_k the held-out RMSE of
+the surrogate (:func:`demcal.discrepancy_extension.rmse_of`), so that a surrogate's own error is
+never mistaken for missing physics.
 
 Over the parameter box (a regular grid, then a bounded local refinement of the best grid point)
 this module finds

@@ -61,7 +61,7 @@ def find_markdown(result: FindResult, material: str, box_bounds: Mapping[str, An
         "",
         f"Gap figure G = sqrt(min chi^2 / N) = sqrt({result.best.deviance:.3g} / {len(obs)}) "
         f"= {result.gap:.3f} (threshold {result.threshold:g}); z = (model - measured) / sigma "
-        "with sigma = sqrt(measurement sd^2 + surrogate test RMSE^2).",
+        "with sigma = sqrt(measurement sd^2 + surrogate held-out RMSE^2).",
         "",
         "Where the disagreement sits:",
         "",

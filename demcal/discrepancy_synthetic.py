@@ -228,10 +228,10 @@ def replicate_record(
 ) -> dict[str, Any]:
     """An experiment-file mapping: the mean of the replicates with its standard deviation.
 
-    Every value is the mean over the replicate runs times (1 + noise * N(0, 1)); its sd is
-    sqrt(s^2 + (noise * mean)^2) with s the sample standard deviation of the replicates (0 for
-    a single run), so the stated uncertainty covers both the scatter of repeated tests and the
-    added measurement noise.
+    Every value is the mean over the n replicate runs times (1 + noise * N(0, 1)); its sd is
+    sqrt(s^2 / n + (noise * mean)^2) with s the sample standard deviation of the replicates (0
+    for a single run): the standard error of the mean combined with the added noise, the
+    uncertainty of the value that is stated.
 
     Parameters
     ----------
@@ -245,7 +245,7 @@ def replicate_record(
     def measured(values: pd.Series) -> tuple[float, float]:
         vals = values.dropna().to_numpy(float)
         mean = float(vals.mean())
-        scatter = float(vals.std(ddof=1)) if vals.size > 1 else 0.0
+        scatter = float(vals.std(ddof=1) / math.sqrt(vals.size)) if vals.size > 1 else 0.0
         value = mean * (1.0 + noise * rng.standard_normal()) if noise > 0 else mean
         return value, math.hypot(scatter, noise * mean)
 

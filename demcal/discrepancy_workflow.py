@@ -52,16 +52,20 @@ __all__ = [
     "RankingResult",
     "build_model",
     "find_from_files",
+    "find_record",
     "load_surrogates",
     "rank",
+    "recalibrate",
     "run_values",
+    "screening_counts",
+    "show",
 ]
 
 
 def load_surrogates(
     paths: Mapping[str, str | Path],
 ) -> tuple[dict[str, tuple[Any, list[str]]], dict[str, float]]:
-    """Saved surrogates (model, input names) and their test RMSE, per observable."""
+    """Saved surrogates (model, input names) and their held-out RMSE, per observable."""
     surrogates = {name: load_surrogate(path) for name, path in paths.items()}
     rmse = {name: rmse_of(path) for name, path in paths.items()}
     return surrogates, rmse
@@ -104,8 +108,8 @@ def build_model(
     """The surrogate model of all measured observations and its parameter box.
 
     The parameters are the surrogate inputs other than the load and the test constants; their
-    bounds come from ``screening.axes`` (else ``design.ranges``), and an added candidate's
-    parameter takes its range from the catalogue.
+    bounds are the screening axes within the design's ranges (the surrogates are not
+    extrapolated), and an added candidate's parameter takes its range from the catalogue.
     """
     obs = observation_table(
         experiment, rmse, float(config["screening"]["tolerance"]), observables=list(surrogates)
@@ -217,8 +221,12 @@ def rank(
     experiment: Experiment,
     config: Mapping[str, Any],
     runs: pd.DataFrame,
+    probe_point: Mapping[str, float],
 ) -> RankingResult:
     """Score every applicable candidate with its probe runs and rank them (BIC).
+
+    ``probe_point`` is the parameter set the probes ran at (``point`` of the Find record); it
+    gives the "absent" magnitude of a candidate whose absence is another parameter's value.
 
     Observations whose reference probe run gave no value are left out of the ranking (and the
     null fit is redone without them); a probe level with a missing value is dropped for its
@@ -255,8 +263,7 @@ def rank(
     noise = obs["surrogate_rmse"].to_numpy(float)
     weights = ranking_sigma(obs["sigma"].to_numpy(float), noise)
     null_weighted = null_fit(model, box, grid, predictions, weights)
-    # The probes ran at theta* of Find (the find.json record), the point used here as well.
-    point = base_point(null.best.theta, config)
+    point = {k: float(v) for k, v in probe_point.items()}
     fits = {}
     rows = []
     for cand in candidates:

@@ -38,7 +38,7 @@ def main(sm) -> None:
         paths = dict(zip(sm.params.outputs, sm.input.models, strict=True))
         runs = read_runs(sm.input.probes)
         runs.to_csv(out.probes, index=False, float_format="%.8g")
-        result = rank(paths, experiment, config, runs)
+        result = rank(paths, experiment, config, runs, find["point"])
         result.table.to_csv(out.table, index=False, float_format="%.6g")
         n_obs = len(result.find.observations)
         Path(out.markdown).write_text(

@@ -179,11 +179,13 @@ def test_replicate_record_states_mean_and_scatter():
     )
     record = replicate_record(bulk, "m", 0.0, 1, "test")
     (entry,) = record["shear_cell"]
-    assert entry["mu_psh"] == pytest.approx(0.6) and entry["mu_psh_sd"] == pytest.approx(0.1)
+    # Standard error of the mean of three: 0.1 / sqrt(3).
+    se = 0.1 / math.sqrt(3.0)
+    assert entry["mu_psh"] == pytest.approx(0.6) and entry["mu_psh_sd"] == pytest.approx(se)
     assert entry["mu_sh_sd"] == 0.0
     assert entry["rho_b"] == pytest.approx(1705.0)
     noisy = replicate_record(bulk, "m", 0.01, 1, "test")["shear_cell"][0]
-    # The sd also covers the added noise: sqrt(0.1^2 + (0.01 * 0.6)^2).
-    assert noisy["mu_psh_sd"] == pytest.approx(math.hypot(0.1, 0.006), rel=1e-5)
+    # The sd also covers the added noise: sqrt(se^2 + (0.01 * 0.6)^2).
+    assert noisy["mu_psh_sd"] == pytest.approx(math.hypot(se, 0.006), rel=1e-5)
     assert noisy["mu_psh"] != pytest.approx(0.6, abs=1e-9)
     assert "angle_of_repose" not in record

@@ -110,11 +110,15 @@ class ComposedModel final : public ContactModel {
     double* hist_all = a.list.history.data();
 #pragma omp parallel num_threads(nthreads) reduction(+ : contacts)
     {
+      // Thread 0 adds straight into the (zeroed) particle arrays; the others into buffers that
+      // are summed in below: one thread needs neither buffers nor a reduction.
       const int tid = omp_get_thread_num();
-      Vec3* f = a.thread_force[tid].data();
-      Vec3* t = a.thread_torque[tid].data();
-      std::fill(f, f + n, Vec3{});
-      std::fill(t, t + n, Vec3{});
+      Vec3* f = tid == 0 ? P.f.data() : a.thread_force[tid].data();
+      Vec3* t = tid == 0 ? P.torque.data() : a.thread_torque[tid].data();
+      if (tid != 0) {
+        std::fill(f, f + n, Vec3{});
+        std::fill(t, t + n, Vec3{});
+      }
       double my_ratio = 0.0;
       long my_tag = -1;
 #pragma omp for schedule(static, 64)
@@ -168,15 +172,18 @@ class ComposedModel final : public ContactModel {
         worst_tag = my_tag;
       }
       // Fixed-order reduction: the sum over threads does not depend on scheduling.
+      const int team = omp_get_num_threads();  // may be fewer than asked for
+      if (team > 1) {
 #pragma omp for schedule(static)
-      for (std::size_t i = 0; i < n; ++i) {
-        Vec3 fs, ts;
-        for (int th = 0; th < nthreads; ++th) {
-          fs += a.thread_force[th][i];
-          ts += a.thread_torque[th][i];
+        for (std::size_t i = 0; i < n; ++i) {
+          Vec3 fs, ts;
+          for (int th = 1; th < team; ++th) {
+            fs += a.thread_force[th][i];
+            ts += a.thread_torque[th][i];
+          }
+          P.f[i] += fs;
+          P.torque[i] += ts;
         }
-        P.f[i] += fs;
-        P.torque[i] += ts;
       }
     }
     a.max_overlap_ratio = worst_ratio;

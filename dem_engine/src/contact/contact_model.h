@@ -31,7 +31,8 @@ struct PairForceArgs {
   const MaterialTable& material;
   const Domain& domain;
   double dt;
-  std::vector<std::vector<Vec3>>& thread_force;   // [thread][particle], zeroed by the callee
+  // [thread][particle] for threads >= 1 (thread 0 adds into atoms), zeroed by the callee
+  std::vector<std::vector<Vec3>>& thread_force;
   std::vector<std::vector<Vec3>>& thread_torque;
   double max_overlap_ratio = 0.0;  // out: largest overlap / smaller radius
   long max_overlap_tag = -1;       // out: tag of a particle in that contact

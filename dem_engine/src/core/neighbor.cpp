@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/threads.h"
+
 namespace dem {
 
 bool NeighborList::due(const Particles& p, long steps_since_build) const {
@@ -12,10 +14,11 @@ bool NeighborList::due(const Particles& p, long steps_since_build) const {
   if (steps_since_build < delay || steps_since_build % std::max(every, 1) != 0) return false;
   if (!check) return true;
   const double limit2 = 0.25 * skin * skin;
-  const std::size_t n = p.size();
-  for (std::size_t i = 0; i < n; ++i)
-    if (norm2(p.x[i] - x_at_build_[i]) > limit2) return true;
-  return false;
+  const long n = static_cast<long>(p.size());
+  bool moved = false;
+#pragma omp parallel for schedule(static) num_threads(worker_threads(p.size())) reduction(|| : moved)
+  for (long i = 0; i < n; ++i) moved = moved || norm2(p.x[i] - x_at_build_[i]) > limit2;
+  return moved;
 }
 
 namespace {
@@ -141,70 +144,80 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   }
 
   const bool any_periodic = domain.periodic(0) || domain.periodic(1) || domain.periodic(2);
-  // Partners are found bin by bin (one stencil per bin) and then stored per particle.
-  std::vector<std::vector<int>> found(n);
-  std::vector<int> stencil;
-  stencil.reserve(27);
-  for (std::size_t b = 0; b < nbins; ++b) {
-    if (bin_start[b] == bin_start[b + 1]) continue;
-    const int bx = static_cast<int>(b % nb[0]), by = static_cast<int>((b / nb[0]) % nb[1]);
-    const int bz = static_cast<int>(b / (static_cast<std::size_t>(nb[0]) * nb[1]));
-    stencil.clear();
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          int c[3] = {bx + dx, by + dy, bz + dz};
-          bool ok = true;
-          for (int k = 0; k < 3 && ok; ++k) {
-            if (c[k] < 0 || c[k] >= nb[k]) {
-              if (domain.periodic(k)) c[k] = (c[k] + nb[k]) % nb[k];
-              else ok = false;
+  // Partners are found bin by bin (one stencil per bin) and stored per particle; every particle
+  // lives in one bin, so the bins can be searched in parallel. The per-particle buffers are kept
+  // between builds: their capacity makes later builds allocation-free.
+  if (found_.size() < n) found_.resize(n);
+  const int nthreads = worker_threads(n);
+#pragma omp parallel num_threads(nthreads)
+  {
+    std::vector<int> stencil;
+    stencil.reserve(27);
+#pragma omp for schedule(dynamic, 16)
+    for (std::size_t b = 0; b < nbins; ++b) {
+      if (bin_start[b] == bin_start[b + 1]) continue;
+      const int bx = static_cast<int>(b % nb[0]), by = static_cast<int>((b / nb[0]) % nb[1]);
+      const int bz = static_cast<int>(b / (static_cast<std::size_t>(nb[0]) * nb[1]));
+      stencil.clear();
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            int c[3] = {bx + dx, by + dy, bz + dz};
+            bool ok = true;
+            for (int k = 0; k < 3 && ok; ++k) {
+              if (c[k] < 0 || c[k] >= nb[k]) {
+                if (domain.periodic(k)) c[k] = (c[k] + nb[k]) % nb[k];
+                else ok = false;
+              }
             }
+            if (!ok) continue;
+            const int cb = (c[2] * nb[1] + c[1]) * nb[0] + c[0];
+            if (std::find(stencil.begin(), stencil.end(), cb) == stencil.end())
+              stencil.push_back(cb);
           }
-          if (!ok) continue;
-          const int cb = (c[2] * nb[1] + c[1]) * nb[0] + c[0];
-          if (std::find(stencil.begin(), stencil.end(), cb) == stencil.end()) stencil.push_back(cb);
+      for (int s = bin_start[b]; s < bin_start[b + 1]; ++s) {
+        const int i = bin_items[s];
+        const Vec3 xi = p.x[i];
+        const double ri = p.radius[i] + skin;
+        auto& out = found_[i];
+        out.clear();
+        for (int cb : stencil) {
+          for (int t = bin_start[cb]; t < bin_start[cb + 1]; ++t) {
+            const int j = bin_items[t];
+            if (j <= i) continue;
+            Vec3 d = xi - p.x[j];
+            if (any_periodic) d = domain.minimum_image(d);
+            const double reach = ri + p.radius[j];
+            if (norm2(d) < reach * reach) out.push_back(j);
+          }
         }
-    for (int s = bin_start[b]; s < bin_start[b + 1]; ++s) {
-      const int i = bin_items[s];
-      const Vec3 xi = p.x[i];
-      const double ri = p.radius[i] + skin;
-      auto& out = found[i];
-      for (int cb : stencil) {
-        for (int t = bin_start[cb]; t < bin_start[cb + 1]; ++t) {
-          const int j = bin_items[t];
-          if (j <= i) continue;
-          Vec3 d = xi - p.x[j];
-          if (any_periodic) d = domain.minimum_image(d);
-          const double reach = ri + p.radius[j];
-          if (norm2(d) < reach * reach) out.push_back(j);
-        }
+        // Sorted partners give a deterministic pair order and allow the merge below.
+        std::sort(out.begin(), out.end());
       }
     }
   }
-  for (std::size_t i = 0; i < n; ++i) {
-    // Sorted partners give a deterministic pair order and allow the merge below.
-    std::sort(found[i].begin(), found[i].end());
-    partner.insert(partner.end(), found[i].begin(), found[i].end());
-    first[i + 1] = static_cast<int>(partner.size());
-  }
-
+  for (std::size_t i = 0; i < n; ++i)
+    first[i + 1] = first[i] + static_cast<int>(found_[i].size());
+  partner.resize(static_cast<std::size_t>(first[n]));
   history.assign(partner.size() * kHistorySize, 0.0);
-  if (same_order) {
-    for (std::size_t i = 0; i < n && i + 1 < old_first.size(); ++i) {
-      int a = old_first[i];
-      const int a_end = old_first[i + 1];
-      for (int k = first[i]; k < first[i + 1] && a < a_end; ++k) {
-        while (a < a_end && old_partner[a] < partner[k]) ++a;
-        if (a < a_end && old_partner[a] == partner[k])
-          std::copy_n(&old_history[static_cast<std::size_t>(a) * kHistorySize], kHistorySize,
-                      &history[static_cast<std::size_t>(k) * kHistorySize]);
-      }
+  const long ln = static_cast<long>(n);
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+  for (long i = 0; i < ln; ++i) {
+    std::copy(found_[i].begin(), found_[i].end(), partner.begin() + first[i]);
+    if (!same_order || static_cast<std::size_t>(i) + 1 >= old_first.size()) continue;
+    int a = old_first[i];
+    const int a_end = old_first[i + 1];
+    for (int k = first[i]; k < first[i + 1] && a < a_end; ++k) {
+      while (a < a_end && old_partner[a] < partner[k]) ++a;
+      if (a < a_end && old_partner[a] == partner[k])
+        std::copy_n(&old_history[static_cast<std::size_t>(a) * kHistorySize], kHistorySize,
+                    &history[static_cast<std::size_t>(k) * kHistorySize]);
     }
-    return;
   }
+  if (same_order) return;
   if (old.empty()) return;
-  for (std::size_t i = 0; i < n; ++i) {
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+  for (long i = 0; i < ln; ++i) {
     for (int k = first[i]; k < first[i + 1]; ++k) {
       bool swapped = false;
       const std::uint64_t key = pair_key(p.tag[i], p.tag[partner[k]], swapped);

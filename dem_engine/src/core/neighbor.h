@@ -36,6 +36,7 @@ class NeighborList {
  private:
   std::vector<Vec3> x_at_build_;
   std::vector<std::int64_t> tags_at_build_;
+  std::vector<std::vector<int>> found_;  // partners per particle, reused between builds
   bool forced_ = true;
   long builds_ = 0;
 };

@@ -66,7 +66,7 @@ void Simulation::compute_forces() {
     const int nthreads = worker_threads(n);
     thread_force_.resize(nthreads);
     thread_torque_.resize(nthreads);
-    for (int t = 0; t < nthreads; ++t) {
+    for (int t = 1; t < nthreads; ++t) {  // thread 0 writes into atoms.f and atoms.torque
       thread_force_[t].resize(n);
       thread_torque_[t].resize(n);
     }
