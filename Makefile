@@ -37,7 +37,7 @@ $(ENGINE): $(ENGINE_SOURCES) | $(PY_STAMP)
 	@install -m 755 $(ENGINE_BUILD)/dem_engine $(ENGINE)
 
 run: setup
-	source $(VENV)/bin/activate && snakemake --cores $(CORES) $(SNAKEMAKE_ARGS) \
+	source $(VENV)/bin/activate && snakemake --cores $(CORES) --force-use-threads $(SNAKEMAKE_ARGS) \
 		&& snakemake --report results/report.html $(SNAKEMAKE_ARGS)
 
 test: setup

@@ -62,7 +62,10 @@ def read_identified_parameters(path: str | Path) -> dict[str, dict[str, float]]:
     Parameters
     ----------
     path : str or Path
-        JSON file ``{"coefficientFriction": {"mean": .., "sd": .., "min": .., "max": ..}, ...}``.
+        The identification record (``results/identification/identified_parameters.json``):
+        a JSON object whose ``parameters`` maps each parameter to its statistics,
+        ``{"parameters": {"coefficientFriction": {"mean": .., "sd": .., "min": .., "max": ..},
+        ...}, ...}``.
 
     Returns
     -------
@@ -72,7 +75,8 @@ def read_identified_parameters(path: str | Path) -> dict[str, dict[str, float]]:
     Raises
     ------
     IdentifiedParametersError
-        Not JSON, not an object of objects, or a statistic is not a finite number.
+        Not JSON, no ``parameters`` object (or an empty one: nothing was identified), or a
+        statistic is not a finite number.
     """
     path = Path(path)
     try:
@@ -81,10 +85,16 @@ def read_identified_parameters(path: str | Path) -> dict[str, dict[str, float]]:
         raise IdentifiedParametersError(
             f"{path}: cannot read identified parameters: {exc}"
         ) from exc
-    if not isinstance(data, dict):
-        raise IdentifiedParametersError(f"{path}: top level must be an object of parameters")
+    params = data.get("parameters") if isinstance(data, dict) else None
+    if not isinstance(params, dict):
+        raise IdentifiedParametersError(f"{path}: needs an object 'parameters'")
+    if not params:
+        raise IdentifiedParametersError(
+            f"{path}: no parameter set was identified (no valid sets); set "
+            "application.parameters in the configuration instead"
+        )
     out: dict[str, dict[str, float]] = {}
-    for name, stats in data.items():
+    for name, stats in params.items():
         if not isinstance(stats, dict):
             raise IdentifiedParametersError(f"{path}: parameter {name!r} must map to an object")
         entry: dict[str, float] = {}

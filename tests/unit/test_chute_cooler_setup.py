@@ -245,13 +245,25 @@ def test_parameters_explicit_identified_or_error():
 
 
 def test_read_identified_parameters(tmp_path):
+    # The record as the identification writes it (demcal.calibration).
     good = tmp_path / "p.json"
-    good.write_text(json.dumps({"density": {"mean": 2900.0, "sd": 10.0, "min": 2800, "max": 3000}}))
+    stats = {"mean": 2900.0, "sd": 10.0, "min": 2800, "max": 3000}
+    good.write_text(
+        json.dumps({"group": "SSC & AoR", "n_total": 10, "parameters": {"density": stats}})
+    )
     assert read_identified_parameters(good)["density"]["min"] == 2800.0
     bad = tmp_path / "bad.json"
-    bad.write_text('{"density": {"mean": "heavy"}}')
+    bad.write_text('{"parameters": {"density": {"mean": "heavy"}}}')
     with pytest.raises(IdentifiedParametersError, match=r"bad\.json.*density\.mean"):
         read_identified_parameters(bad)
+    flat = tmp_path / "flat.json"
+    flat.write_text(json.dumps({"density": stats}))
+    with pytest.raises(IdentifiedParametersError, match=r"flat\.json.*'parameters'"):
+        read_identified_parameters(flat)
+    empty = tmp_path / "empty.json"
+    empty.write_text('{"group": "SSC", "parameters": {}}')
+    with pytest.raises(IdentifiedParametersError, match="no parameter set was identified"):
+        read_identified_parameters(empty)
     with pytest.raises(IdentifiedParametersError, match=r"missing\.json"):
         read_identified_parameters(tmp_path / "missing.json")
 

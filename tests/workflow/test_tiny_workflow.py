@@ -32,6 +32,7 @@ def snakemake(workdir: Path, *args: str, timeout: float = 1500) -> subprocess.Co
             str(workdir),
             "--cores",
             "2",
+            "--force-use-threads",  # as `make run`
             "--configfile",
             str(workdir / "config.yaml"),
             *args,
