@@ -26,12 +26,10 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from demcal.bulk_values import extract
 from demcal.cases import load_condition, shear_suffixes
 from demcal.config import validate_config
-from demcal.decks import render_case
-from demcal.dem_run import run_deck
 from demcal.discrepancy_candidates import deep_merge
+from demcal.synthetic_experiment import run_case_bulk
 
 __all__ = [
     "hidden_effect_bulk",
@@ -204,17 +202,7 @@ def hidden_effect_bulk(
         test, case, r = item
         run_cfg = deep_merge(cfg, {"seed": int(cfg["seed"]) + r})
         case_dir = Path(work_dir) / test / case["case_id"]
-        info = render_case(test, case, run_cfg, case_dir)
-        status = run_deck(
-            case_dir,
-            Path(info["deck"]).name,
-            cfg["engine"]["command"],
-            int(cfg["engine"]["threads"]),
-        )
-        if status["status"] != "ok":
-            raise RuntimeError(f"truth run {case_dir} failed: {status['error']}")
-        rows = extract(test, case_dir)
-        rows["test"] = test
+        rows = run_case_bulk(test, case, run_cfg, case_dir, "truth run")
         rows["replicate"] = r
         return rows
 

@@ -28,20 +28,38 @@ def simulate_reference(
         key = f"reference{suffix}"
         cases.append(("shear_cell", {"case_id": key, **parameters, **load_condition(config, key)}))
     for test, case in cases:
-        case_dir = work_dir / test / case["case_id"]
-        info = render_case(test, case, config, case_dir)
-        status = run_deck(
-            case_dir,
-            Path(info["deck"]).name,
-            config["engine"]["command"],
-            int(config["engine"]["threads"]),
+        frames.append(
+            run_case_bulk(test, case, config, work_dir / test / case["case_id"], "reference run")
         )
-        if status["status"] != "ok":
-            raise RuntimeError(f"reference run {case_dir} failed: {status['error']}")
-        rows = extract(test, case_dir)
-        rows["test"] = test
-        frames.append(rows)
     return pd.concat(frames, ignore_index=True)
+
+
+def run_case_bulk(
+    test: str,
+    case: Mapping[str, Any],
+    config: Mapping[str, Any],
+    case_dir: Path,
+    label: str,
+) -> pd.DataFrame:
+    """Render, run and read one case: its bulk-value rows with a ``test`` column.
+
+    Raises
+    ------
+    RuntimeError
+        When the engine run fails (the message starts with ``label`` and names ``case_dir``).
+    """
+    info = render_case(test, case, config, case_dir)
+    status = run_deck(
+        case_dir,
+        Path(info["deck"]).name,
+        config["engine"]["command"],
+        int(config["engine"]["threads"]),
+    )
+    if status["status"] != "ok":
+        raise RuntimeError(f"{label} {case_dir} failed: {status['error']}")
+    rows = extract(test, case_dir)
+    rows["test"] = test
+    return rows
 
 
 def experiment_record(
