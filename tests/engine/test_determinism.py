@@ -65,6 +65,16 @@ def test_same_deck_one_thread_is_bitwise_repeatable(tmp_path):
     assert (a.directory / "final.dump").read_bytes() == (b.directory / "final.dump").read_bytes()
 
 
+def test_same_deck_two_threads_is_bitwise_repeatable(tmp_path):
+    # The split of the particles between threads depends on the contacts only, never on
+    # timing, and thread sums are added in a fixed order.
+    deck = settling_deck(1500)
+    a = run_engine(tmp_path / "a", deck, threads=2)
+    b = run_engine(tmp_path / "b", deck, threads=2)
+    assert "on 2 threads" in a.stdout
+    assert (a.directory / "final.dump").read_bytes() == (b.directory / "final.dump").read_bytes()
+
+
 def test_one_and_two_threads_agree(tmp_path):
     deck = settling_deck(3000)
     x1, ke1 = _final(run_engine(tmp_path / "t1", deck, threads=1))

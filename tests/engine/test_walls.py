@@ -116,9 +116,17 @@ def test_sphere_rests_on_plane_at_hertz_static_overlap(tmp_path, wall, side):
 
 
 @pytest.mark.parametrize(
-    ("wall", "start"), [("primitive", "inside"), ("primitive", "outside"), ("mesh", "inside")]
+    ("wall", "start", "neigh"),
+    [
+        ("primitive", "inside", ""),
+        ("primitive", "outside", ""),
+        ("mesh", "inside", ""),
+        # Rebuilds 7 000 steps (4.2 mm of travel) apart: primitive walls must then check every
+        # particle at every step instead of those near them at the last build.
+        ("primitive", "outside", "neigh_modify delay 7000\n"),
+    ],
 )
-def test_sphere_bounces_back_from_cylinder_wall(tmp_path, wall, start):
+def test_sphere_bounces_back_from_cylinder_wall(tmp_path, wall, start, neigh):
     r, rho, rc, e, speed = 0.002, 2500.0, 0.02, 0.8, 0.3
     cx, cy = 0.005, -0.003
     # Direction of travel: through the middle of a facet of the STL cylinder.
@@ -141,6 +149,7 @@ def test_sphere_bounces_back_from_cylinder_wall(tmp_path, wall, start):
     x0, y0 = cx + d0 * ux, cy + d0 * uy
     deck = (
         preamble(restitution=e, friction=0.0, dt=2e-6)
+        + neigh
         + wall_lines
         + f"create_atoms 1 single {x0!r} {y0!r} 0 units box\n"
         + f"set atom 1 diameter {2 * r!r} density {rho!r} vx {v0 * ux!r} vy {v0 * uy!r}\n"

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "contact/cohesion_none.h"
 #include "contact/cohesion_sjkr.h"
@@ -12,6 +14,7 @@
 #include "contact/rolling_none.h"
 #include "contact/tangential_history.h"
 #include "core/numbers.h"
+#include "core/threads.h"
 #include "deck/errors.h"
 
 namespace dem {
@@ -108,63 +111,111 @@ class ComposedModel final : public ContactModel {
     const int* first = a.list.first.data();
     const int* partner = a.list.partner.data();
     double* hist_all = a.list.history.data();
+    std::uint8_t* touching = a.list.touching.data();
+    int max_pairs = 0;
+    for (std::size_t i = 0; i < n; ++i) max_pairs = std::max(max_pairs, first[i + 1] - first[i]);
+    // Per thread: one past the largest particle index it adds forces to.
+    std::vector<std::size_t> touched_end(static_cast<std::size_t>(nthreads), 0);
 #pragma omp parallel num_threads(nthreads) reduction(+ : contacts)
     {
-      // Thread 0 adds straight into the (zeroed) particle arrays; the others into buffers that
+      // Each thread takes the pairs of its own share of particles (the list's partition, as
+      // every per-particle loop does). Thread 0 adds straight into the particle arrays, the others
+      // into buffers, from the start of their share up to their largest partner index, that
       // are summed in below: one thread needs neither buffers nor a reduction.
       const int tid = omp_get_thread_num();
+      const int team = omp_get_num_threads();  // may be fewer than asked for
+      const ParticleShare own = a.list.partition().share(n, tid, team);
+      std::size_t end_j = own.end;
+      for (std::size_t i = own.begin; i < own.end; ++i)
+        if (first[i + 1] > first[i])
+          end_j = std::max(end_j, static_cast<std::size_t>(partner[first[i + 1] - 1]) + 1);
+      touched_end[static_cast<std::size_t>(tid)] = end_j;
       Vec3* f = tid == 0 ? P.f.data() : a.thread_force[tid].data();
       Vec3* t = tid == 0 ? P.torque.data() : a.thread_torque[tid].data();
+      std::fill(P.f.data() + own.begin, P.f.data() + own.end, Vec3{});
+      std::fill(P.torque.data() + own.begin, P.torque.data() + own.end, Vec3{});
       if (tid != 0) {
-        std::fill(f, f + n, Vec3{});
-        std::fill(t, t + n, Vec3{});
+        std::fill(f + own.begin, f + end_j, Vec3{});
+        std::fill(t + own.begin, t + end_j, Vec3{});
       }
+      std::vector<int> hits(static_cast<std::size_t>(max_pairs));
+      std::vector<ContactInput> inputs(static_cast<std::size_t>(max_pairs));
       double my_ratio = 0.0;
       long my_tag = -1;
-#pragma omp for schedule(static, 64)
-      for (std::size_t i = 0; i < n; ++i) {
-        for (int k = first[i]; k < first[i + 1]; ++k) {
+#pragma omp barrier
+      for (std::size_t i = own.begin; i < own.end; ++i) {
+        const int k_end = first[i + 1];
+        if (first[i] == k_end) continue;
+        const Vec3 xi = x[i];
+        const double ri = rad[i];
+        // Pass 1 sorts the listed pairs into touching ones, without branching on a
+        // coin-flip condition, and clears the history of contacts that just opened (a byte
+        // flag per pair keeps the history of pairs apart out of the cache).
+        int m = 0;
+        for (int k = first[i]; k < k_end; ++k) {
           const int j = partner[k];
-          Vec3 d = x[i] - x[j];
+          Vec3 d = xi - x[j];
           if constexpr (Periodic) d = a.domain.minimum_image(d);
-          const double r2 = norm2(d);
-          const double radsum = rad[i] + rad[j];
-          double* hist = hist_all + static_cast<std::size_t>(k) * kHistorySize;
-          if (r2 >= radsum * radsum) {
-            // Most listed pairs are apart and already cleared: read before writing.
-            if (hist[0] != 0.0 || hist[1] != 0.0 || hist[2] != 0.0 || hist[3] != 0.0 ||
-                hist[4] != 0.0 || hist[5] != 0.0)
-              for (int h = 0; h < kHistorySize; ++h) hist[h] = 0.0;
-            continue;
+          const double radsum = ri + rad[j];
+          const bool apart = norm2(d) >= radsum * radsum;
+          hits[m] = k;
+          m += !apart;
+          if (apart && touching[k]) {
+            touching[k] = 0;
+            std::fill_n(hist_all + static_cast<std::size_t>(k) * kHistorySize, kHistorySize, 0.0);
           }
-          ++contacts;
-          const double r = std::sqrt(r2);
-          ContactInput c;
+        }
+        if (m == 0) continue;
+        contacts += m;
+        // Pass 2 sets up the geometry of all contacts of i before pass 3 runs their laws:
+        // the square roots and divisions of different contacts then overlap in the pipeline.
+        const Vec3 vi = v[i], wi = w[i];
+        const double mi = mass[i];
+        for (int h = 0; h < m; ++h) {
+          const int j = partner[hits[h]];
+          Vec3 d = xi - x[j];
+          if constexpr (Periodic) d = a.domain.minimum_image(d);
+          const double r = std::sqrt(norm2(d));
+          const double rj = rad[j];
+          const double radsum = ri + rj;
+          ContactInput& c = inputs[h];
           c.dist = r;
           c.n = (1.0 / r) * d;
           c.overlap = radsum - r;
-          c.ri = rad[i];
-          c.rj = rad[j];
-          c.r_eff = rad[i] * rad[j] / radsum;
-          c.m_eff = mass[i] * mass[j] / (mass[i] + mass[j]);
-          c.cri = rad[i] - 0.5 * c.overlap;
-          c.crj = rad[j] - 0.5 * c.overlap;
-          c.v_rel = v[i] - v[j];
-          c.omega_i = w[i];
+          c.ri = ri;
+          c.rj = rj;
+          c.r_eff = ri * rj / radsum;
+          c.m_eff = mi * mass[j] / (mi + mass[j]);
+          c.cri = ri - 0.5 * c.overlap;
+          c.crj = rj - 0.5 * c.overlap;
+          c.v_rel = vi - v[j];
+          c.omega_i = wi;
           c.omega_j = w[j];
+        }
+        // Pass 3: the contact laws. Partners have j > i, so the sums on i stay in registers.
+        Vec3 fi = f[i], ti = t[i];
+        const int type_i = type[i];
+        for (int h = 0; h < m; ++h) {
+          const int k = hits[h];
+          const int j = partner[k];
+          const ContactInput& c = inputs[h];
+          touching[k] = 1;
           ContactResult res;
-          contact_law<Cohesion, Rolling>(c, a.material.get(type[i], type[j]), opt, a.dt, hist,
+          contact_law<Cohesion, Rolling>(c, a.material.get(type_i, type[j]), opt, a.dt,
+                                         hist_all + static_cast<std::size_t>(k) * kHistorySize,
                                          res);
-          f[i] += res.force;
+          fi += res.force;
           f[j] -= res.force;
-          t[i] += res.torque_i;
+          ti += res.torque_i;
           t[j] += res.torque_j;
-          const double ratio = c.overlap / std::min(rad[i], rad[j]);
-          if (ratio > my_ratio) {
-            my_ratio = ratio;
+          const double rmin = std::min(c.ri, c.rj);
+          if (c.overlap > my_ratio * rmin) {
+            my_ratio = c.overlap / rmin;
             my_tag = P.tag[i];
           }
         }
+        f[i] = fi;
+        t[i] = ti;
       }
 #pragma omp critical
       if (my_ratio > worst_ratio) {
@@ -172,12 +223,12 @@ class ComposedModel final : public ContactModel {
         worst_tag = my_tag;
       }
       // Fixed-order reduction: the sum over threads does not depend on scheduling.
-      const int team = omp_get_num_threads();  // may be fewer than asked for
       if (team > 1) {
-#pragma omp for schedule(static)
-        for (std::size_t i = 0; i < n; ++i) {
+#pragma omp barrier
+        for (std::size_t i = own.begin; i < own.end; ++i) {
           Vec3 fs, ts;
           for (int th = 1; th < team; ++th) {
+            if (i < a.list.partition().share(n, th, team).begin || i >= touched_end[th]) continue;
             fs += a.thread_force[th][i];
             ts += a.thread_torque[th][i];
           }

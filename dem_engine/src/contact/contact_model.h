@@ -49,7 +49,8 @@ class ContactModel {
   // One contact: updates history (kHistorySize doubles) and fills result.
   virtual void evaluate(const ContactInput& c, const PairParams& p, double dt, double* history,
                         ContactResult& result) const = 0;
-  // All particle pairs of the neighbour list; forces/torques summed into f and torque.
+  // All particle pairs of the neighbour list; sets f and torque of every particle to the sum
+  // of its pair forces and torques.
   virtual void pair_forces(PairForceArgs& args) const = 0;
 
  private:

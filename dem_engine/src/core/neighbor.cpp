@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 
@@ -14,11 +15,17 @@ bool NeighborList::due(const Particles& p, long steps_since_build) const {
   if (steps_since_build < delay || steps_since_build % std::max(every, 1) != 0) return false;
   if (!check) return true;
   const double limit2 = 0.25 * skin * skin;
-  const std::size_t n = p.size();
-  // Serial on purpose: the scan costs microseconds, less than one more barrier per step.
-  for (std::size_t i = 0; i < n; ++i)
-    if (norm2(p.x[i] - x_at_build_[i]) > limit2) return true;
-  return false;
+  // Each thread scans its own share of the particles: one thread reading all positions would
+  // pull them into its cache every step.
+  std::atomic<bool> moved{false};
+  partition_.for_each(p.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (norm2(p.x[i] - x_at_build_[i]) > limit2) {
+        moved.store(true, std::memory_order_relaxed);
+        return;
+      }
+  });
+  return moved.load();
 }
 
 namespace {
@@ -34,6 +41,12 @@ std::uint64_t pair_key(std::int64_t a, std::int64_t b, bool& swapped) {
   const auto lo = static_cast<std::uint64_t>(swapped ? b : a);
   const auto hi = static_cast<std::uint64_t>(swapped ? a : b);
   return (lo << 32) ^ hi;
+}
+
+bool any_nonzero(const double* hist) {
+  for (int c = 0; c < kHistorySize; ++c)
+    if (hist[c] != 0.0) return true;
+  return false;
 }
 
 }  // namespace
@@ -80,9 +93,7 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
     for (std::size_t i = 0; i + 1 < first.size(); ++i) {
       for (int k = first[i]; k < first[i + 1]; ++k) {
         const double* h = &history[static_cast<std::size_t>(k) * kHistorySize];
-        bool any = false;
-        for (int c = 0; c < kHistorySize; ++c) any = any || h[c] != 0.0;
-        if (!any) continue;
+        if (!any_nonzero(h)) continue;
         OldContact oc;
         oc.key = pair_key(tags_at_build_[i], tags_at_build_[partner[k]], oc.swapped);
         std::copy(h, h + kHistorySize, oc.hist.begin());
@@ -100,7 +111,10 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   tags_at_build_ = p.tag;
   forced_ = false;
   ++builds_;
-  if (n == 0) return;
+  if (n == 0) {
+    mark_touching(1);
+    return;
+  }
 
   double rmax = 0.0;
   Vec3 lo = p.x[0], hi = p.x[0];
@@ -214,22 +228,45 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
                     &history[static_cast<std::size_t>(k) * kHistorySize]);
     }
   }
-  if (same_order) return;
-  if (old.empty()) return;
+  if (!same_order && !old.empty()) {
 #pragma omp parallel for schedule(static) num_threads(nthreads)
-  for (long i = 0; i < ln; ++i) {
-    for (int k = first[i]; k < first[i + 1]; ++k) {
-      bool swapped = false;
-      const std::uint64_t key = pair_key(p.tag[i], p.tag[partner[k]], swapped);
-      auto it = std::lower_bound(old.begin(), old.end(), key,
-                                 [](const OldContact& a, std::uint64_t kk) { return a.key < kk; });
-      if (it == old.end() || it->key != key) continue;
-      // History is oriented from the first to the second particle of the pair.
-      const double sign = swapped == it->swapped ? 1.0 : -1.0;
-      double* h = &history[static_cast<std::size_t>(k) * kHistorySize];
-      for (int c = 0; c < kHistorySize; ++c) h[c] = sign * it->hist[c];
+    for (long i = 0; i < ln; ++i) {
+      for (int k = first[i]; k < first[i + 1]; ++k) {
+        bool swapped = false;
+        const std::uint64_t key = pair_key(p.tag[i], p.tag[partner[k]], swapped);
+        auto it = std::lower_bound(
+            old.begin(), old.end(), key,
+            [](const OldContact& a, std::uint64_t kk) { return a.key < kk; });
+        if (it == old.end() || it->key != key) continue;
+        // History is oriented from the first to the second particle of the pair.
+        const double sign = swapped == it->swapped ? 1.0 : -1.0;
+        double* h = &history[static_cast<std::size_t>(k) * kHistorySize];
+        for (int c = 0; c < kHistorySize; ++c) h[c] = sign * it->hist[c];
+      }
     }
   }
+  mark_touching(nthreads);
+}
+
+void NeighborList::mark_touching(int nthreads) {
+  const std::size_t n = first.size() - 1;
+  touching.resize(partner.size());
+  // The work of a particle in a step: its contacts dominate (pairs apart cost little), the
+  // integrator and the other per-particle loops cost about half a contact.
+  std::vector<long> work(n + 1, 0);
+  const long ln = static_cast<long>(n);
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+  for (long i = 0; i < ln; ++i) {
+    long contacts = 0;
+    for (int k = first[i]; k < first[i + 1]; ++k) {
+      const bool any = any_nonzero(&history[static_cast<std::size_t>(k) * kHistorySize]);
+      touching[static_cast<std::size_t>(k)] = any ? 1 : 0;
+      contacts += any ? 1 : 0;
+    }
+    work[static_cast<std::size_t>(i) + 1] = 1 + 2 * contacts;
+  }
+  for (std::size_t i = 0; i < n; ++i) work[i + 1] += work[i];
+  partition_.balance(work, nthreads);
 }
 
 }  // namespace dem

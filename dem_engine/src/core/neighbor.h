@@ -5,6 +5,7 @@
 #include "contact/contact_types.h"
 #include "core/domain.h"
 #include "core/particles.h"
+#include "core/threads.h"
 
 namespace dem {
 
@@ -24,18 +25,31 @@ class NeighborList {
   std::vector<int> first;         // size n+1: pairs of i are [first[i], first[i+1])
   std::vector<int> partner;       // j for every pair
   std::vector<double> history;    // kHistorySize doubles per pair
+  // Per pair: 1 while its history may be non-zero (the pair touched at its last evaluation);
+  // 0 guarantees a zero history, so pairs apart need not read it.
+  std::vector<std::uint8_t> touching;
 
+  // True when every rebuild check is done at every step, so that no particle moves more than
+  // skin/2 between two builds: anything farther than the skin at a build cannot touch before
+  // the next one (walls use this to skip particles far from them).
+  bool bounds_motion() const { return check && every <= 1 && delay <= 0; }
   // True when a rebuild is due at this step (displacement beyond skin/2, or forced).
   bool due(const Particles& p, long steps_since_build) const;
   void force_rebuild() { forced_ = true; }
   // Rebuilds the list; `extra_cutoff` widens the search (largest radius to be inserted).
   void build(const Particles& p, const Domain& domain);
   long builds() const { return builds_; }
+  // The split of the particles between threads, balanced by contacts at every build.
+  const ParticlePartition& partition() const { return partition_; }
   std::size_t pairs() const { return partner.size(); }
 
  private:
+  // Sets `touching` from the history and balances the partition by contacts.
+  void mark_touching(int nthreads);
+
   std::vector<Vec3> x_at_build_;
   std::vector<std::int64_t> tags_at_build_;
+  ParticlePartition partition_;
   std::vector<std::vector<int>> found_;  // partners per particle, reused between builds
   bool forced_ = true;
   long builds_ = 0;

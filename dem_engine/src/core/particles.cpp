@@ -9,8 +9,6 @@ double sphere_mass(double radius, double density) {
   return 4.0 / 3.0 * M_PI * radius * radius * radius * density;
 }
 
-double sphere_inertia(double mass, double radius) { return 0.4 * mass * radius * radius; }
-
 std::size_t Particles::add(std::int64_t id, int atom_type, std::uint32_t group_mask,
                            const Vec3& position, double particle_radius, double particle_density) {
   tag.push_back(id);

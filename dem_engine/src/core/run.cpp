@@ -60,9 +60,10 @@ class Progress {
 
 void Simulation::compute_forces() {
   const std::size_t n = atoms.size();
-  std::fill(atoms.f.begin(), atoms.f.end(), Vec3{});
-  std::fill(atoms.torque.begin(), atoms.torque.end(), Vec3{});
-  if (pair && n > 0) {
+  if (!pair || n == 0) {
+    std::fill(atoms.f.begin(), atoms.f.end(), Vec3{});
+    std::fill(atoms.torque.begin(), atoms.torque.end(), Vec3{});
+  } else {  // the pair forces overwrite f and torque
     const int nthreads = worker_threads(n);
     thread_force_.resize(nthreads);
     thread_torque_.resize(nthreads);

@@ -1,4 +1,5 @@
 // Fix styles of the core: material properties, gravity, integration, freezing.
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -56,8 +57,10 @@ class FixGravity : public Fix {
   void post_force() override {
     auto& P = sim_.atoms;
     const std::uint32_t bit = group_bit();
-    for (std::size_t i = 0; i < P.size(); ++i)
-      if (P.mask[i] & bit) P.f[i] += P.rmass[i] * accel_;
+    sim_.neighbor.partition().for_each(P.size(), [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i)
+        if (P.mask[i] & bit) P.f[i] += P.rmass[i] * accel_;
+    });
   }
   const Vec3& acceleration() const { return accel_; }
 
@@ -79,16 +82,28 @@ class FixNveSphere : public Fix {
     auto& P = sim_.atoms;
     const double dt = sim_.dt, half = 0.5 * dt;
     const std::uint32_t bit = group_bit();
-    const std::size_t n = P.size();
-#pragma omp parallel for schedule(static) num_threads(worker_threads(n))
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!(P.mask[i] & bit)) continue;
-      const double inv_m = 1.0 / P.rmass[i];
-      const double inv_i = 1.0 / sphere_inertia(P.rmass[i], P.radius[i]);
-      P.v[i] += (half * inv_m) * P.f[i];
-      P.omega[i] += (half * inv_i) * P.torque[i];
-      if (drift) P.x[i] += dt * P.v[i];
-    }
+    const double* mass = P.rmass.data();
+    const double* rad = P.radius.data();
+    sim_.neighbor.partition().for_each(P.size(), [&](std::size_t begin, std::size_t end) {
+      // Blocks of particles: the inverse masses and inertias of a block are computed in a
+      // loop of their own, which the compiler vectorises (the divisions dominate otherwise).
+      constexpr std::size_t kBlock = 64;
+      double inv_m[kBlock], inv_i[kBlock];
+      for (std::size_t lo = begin; lo < end; lo += kBlock) {
+        const std::size_t m = std::min(kBlock, end - lo);
+        for (std::size_t k = 0; k < m; ++k) {
+          inv_m[k] = 1.0 / mass[lo + k];
+          inv_i[k] = 1.0 / sphere_inertia(mass[lo + k], rad[lo + k]);
+        }
+        for (std::size_t k = 0; k < m; ++k) {
+          const std::size_t i = lo + k;
+          if (!(P.mask[i] & bit)) continue;
+          P.v[i] += (half * inv_m[k]) * P.f[i];
+          P.omega[i] += (half * inv_i[k]) * P.torque[i];
+          if (drift) P.x[i] += dt * P.v[i];
+        }
+      }
+    });
   }
 };
 

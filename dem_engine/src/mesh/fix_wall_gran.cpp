@@ -8,6 +8,7 @@
 
 #include "core/numbers.h"
 #include "core/simulation.h"
+#include "core/threads.h"
 #include "deck/errors.h"
 
 namespace dem {
@@ -136,23 +137,49 @@ void FixWallGran::post_force() {
   else primitive_forces();
 }
 
-void FixWallGran::primitive_forces() {
+void FixWallGran::find_near_primitive() {
   Particles& P = sim_.atoms;
   const std::size_t n = P.size();
   const std::uint32_t bit = group_bit();
   double* hist_all = P.extra(history_).data();
+  const NeighborList& list = sim_.neighbor;
+  // Without the skin bound every particle stays a candidate, checked at every step.
+  const double margin = list.bounds_motion() ? list.skin : 1e300;
+  near_.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 normal;
+    double dist = 0.0;
+    if ((P.mask[i] & bit) && wall_.contact(P.x[i], P.radius[i] + margin, normal, dist))
+      near_.push_back(i);
+    else
+      std::fill_n(hist_all + i * kHistorySize, kHistorySize, 0.0);
+  }
+  near_builds_ = list.bounds_motion() ? list.builds() : -1;
+  near_count_of_ = n;
+}
+
+void FixWallGran::primitive_forces() {
+  Particles& P = sim_.atoms;
+  if (near_builds_ != sim_.neighbor.builds() || near_count_of_ != P.size()) find_near_primitive();
+  const std::size_t n = P.size();
+  double* hist_all = P.extra(history_).data();
   double worst = 0.0;
   long worst_tag = -1;
-#pragma omp parallel if (n >= kParallelMin)
+#pragma omp parallel num_threads(worker_threads(n)) if (n >= kParallelMin)
   {
     double my_worst = 0.0;
     long my_tag = -1;
-#pragma omp for schedule(static, 64)
-    for (std::size_t i = 0; i < n; ++i) {
+    // The candidates (sorted) in the thread's own share of the particles.
+    const ParticleShare own =
+        sim_.neighbor.partition().share(n, omp_get_thread_num(), omp_get_num_threads());
+    const auto from = std::lower_bound(near_.begin(), near_.end(), own.begin);
+    const auto to = std::lower_bound(from, near_.end(), own.end);
+    for (auto it = from; it != to; ++it) {
+      const std::size_t i = *it;
       double* hist = hist_all + i * kHistorySize;
       Vec3 normal;
       double dist = 0.0;
-      if (!(P.mask[i] & bit) || !wall_.contact(P.x[i], P.radius[i], normal, dist)) {
+      if (!wall_.contact(P.x[i], P.radius[i], normal, dist)) {
         std::fill(hist, hist + kHistorySize, 0.0);
         continue;
       }
@@ -203,8 +230,9 @@ void FixWallGran::mesh_forces() {
     Scratch& s = scratch_[omp_get_thread_num()];
     double my_worst = 0.0;
     long my_tag = -1;
-#pragma omp for schedule(static, 64)
-    for (std::size_t i = 0; i < n; ++i) {
+    const ParticleShare own =
+        sim_.neighbor.partition().share(n, omp_get_thread_num(), omp_get_num_threads());
+    for (std::size_t i = own.begin; i < own.end; ++i) {
       double* slots = slots_all + i * kMeshSlots * kMeshSlotWidth;
       s.contacts.clear();
       if (P.mask[i] & bit)

@@ -19,7 +19,8 @@ namespace dem {
 // Particles of the group interact with the wall from the side their centre is on; forces and
 // torques are added in post_force. One contact history per particle and contact (primitive:
 // one; mesh: up to kMeshSlots, see assign_history_slots) lives in per-particle storage and is
-// cleared when the contact opens. Mesh candidates come from a TriangleNeighborList rebuilt
+// cleared when the contact opens. Primitive-wall candidates are the particles near the wall at
+// the last neighbour build; mesh candidates come from a TriangleNeighborList rebuilt
 // when particles or meshes moved more than skin/2.
 class FixWallGran : public Fix {
  public:
@@ -32,6 +33,7 @@ class FixWallGran : public Fix {
  private:
   void check_model() const;
   void primitive_forces();
+  void find_near_primitive();
   void mesh_forces();
   void finish_step(double worst_ratio, long worst_tag, long overflow);
 
@@ -40,6 +42,11 @@ class FixWallGran : public Fix {
   // primitive
   PrimitiveWall wall_;
   int wall_type_ = 0;
+  // Particles within reach of the primitive wall at the last neighbour build (all others are
+  // too far to touch it before the next build).
+  std::vector<std::size_t> near_;
+  long near_builds_ = -1;
+  std::size_t near_count_of_ = 0;
   // mesh
   std::vector<std::string> mesh_ids_;
   std::vector<FixMeshSurface*> mesh_fixes_;  // refreshed at every init
