@@ -3,7 +3,10 @@
 Usage: python dem_engine/bench/run_bench.py [--engine PATH] [--steps N] [--repeats K]
 Prints, per variant (hertz + history + EPSD2, and with SJKR) and thread count, the dense-phase
 particle-steps per second (best and median of K timed repeats in one process, after the heap has
-come to rest) and the peak resident memory per particle.
+come to rest) and the peak resident memory per particle. Around each 2-thread run it prints the
+cache-line round trip between the two cores (dem_core_latency, built beside the engine): on a
+shared virtual machine it changes while the host moves the virtual CPUs, and the 2-thread speed
+follows it.
 """
 
 import argparse
@@ -28,6 +31,17 @@ def deck_text(cohesion: bool) -> str:
         sjkr = "model hertz tangential history cohesion sjkr rolling_friction epsd2"
         text = text.replace(f'variable model string "{plain}"', f'variable model string "{sjkr}"')
     return text.replace("if_cohesion_placeholder", "pair_style gran ${model}")
+
+
+def core_round_trip_ns(probe: Path) -> str:
+    """Cache-line round trip between cores 0 and 1 (ns): the range of three samples, or why not."""
+    if not probe.exists():
+        return f"not measured ({probe} is not built)"
+    res = subprocess.run([str(probe), "0", "1", "3"], capture_output=True, text=True)
+    if res.returncode != 0:
+        return f"not measured ({res.stderr.strip()})"
+    samples = [float(v) for v in res.stdout.split()]
+    return f"{min(samples):.0f}-{max(samples):.0f} ns"
 
 
 def run_once(engine: str, cohesion: bool, threads: int, steps: int, repeats: int) -> dict:
@@ -93,10 +107,13 @@ def main() -> None:
         f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; "
         f"engine: {args.engine}"
     )
+    probe = ROOT / "build" / "engine" / "dem_core_latency"
     for cohesion in (False, True):
         name = "hertz+history+epsd2" + ("+sjkr" if cohesion else "")
         rates = {}
         for threads in (1, 2):
+            if threads == 2:
+                print(f"{name:28s} core-to-core round trip before: {core_round_trip_ns(probe)}")
             r = run_once(args.engine, cohesion, threads, args.steps, args.repeats)
             rates[threads] = r["rate"]
             print(
@@ -105,6 +122,7 @@ def main() -> None:
                 f"(median of {args.repeats}: {r['median'] / 1e6:.2f} M); "
                 f"peak memory {r['peak_kib'] / r['atoms']:.2f} KiB/particle"
             )
+        print(f"{name:28s} core-to-core round trip after: {core_round_trip_ns(probe)}")
         print(f"{name:28s} speed-up 2 threads / 1 thread: {rates[2] / rates[1]:.2f}x")
 
 

@@ -112,8 +112,7 @@ class ComposedModel final : public ContactModel {
     const int* partner = a.list.partner.data();
     double* hist_all = a.list.history.data();
     std::uint8_t* touching = a.list.touching.data();
-    int max_pairs = 0;
-    for (std::size_t i = 0; i < n; ++i) max_pairs = std::max(max_pairs, first[i + 1] - first[i]);
+    const int max_pairs = a.list.max_pairs_per_particle();
     // Per thread: one past the largest particle index it adds forces to.
     std::vector<std::size_t> touched_end(static_cast<std::size_t>(nthreads), 0);
 #pragma omp parallel num_threads(nthreads) reduction(+ : contacts)

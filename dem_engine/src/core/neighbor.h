@@ -42,6 +42,7 @@ class NeighborList {
   // The split of the particles between threads, balanced by contacts at every build.
   const ParticlePartition& partition() const { return partition_; }
   std::size_t pairs() const { return partner.size(); }
+  int max_pairs_per_particle() const { return max_pairs_; }
 
  private:
   // Sets `touching` from the history and balances the partition by contacts.
@@ -53,6 +54,7 @@ class NeighborList {
   std::vector<std::vector<int>> found_;  // partners per particle, reused between builds
   bool forced_ = true;
   long builds_ = 0;
+  int max_pairs_ = 0;
 };
 
 }  // namespace dem
