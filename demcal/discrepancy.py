@@ -369,7 +369,10 @@ class FindResult:
     threshold : float
         Gap at or below which the disagreement counts as noise.
     sentences : list[str]
-        Where the disagreement sits, one sentence per observable.
+        Where the disagreement sits, one sentence per observable, and one more when theta* sits
+        on the boundary of the box.
+    pinned : dict[str, str]
+        Parameters of theta* on a bound of the box: name -> "lower" or "upper".
     """
 
     observations: pd.DataFrame
@@ -377,6 +380,7 @@ class FindResult:
     gap: float
     threshold: float
     sentences: list[str]
+    pinned: dict[str, str] = field(default_factory=dict)
 
     @property
     def missing(self) -> bool:
@@ -390,7 +394,54 @@ class FindResult:
                 f"gap {self.gap:.2f} > {self.threshold:g}: the model cannot reproduce the "
                 "measurements within their uncertainty -> a physical effect is missing"
             )
-        return f"gap {self.gap:.2f} <= {self.threshold:g}: within noise -> nothing missing"
+        text = f"gap {self.gap:.2f} <= {self.threshold:g}: within noise -> nothing missing"
+        if self.pinned:
+            text += f", but theta* sits on the box boundary ({', '.join(self.pinned)})"
+        return text
+
+
+def pinned_parameters(
+    theta: Mapping[str, float], box: ParameterBox, rel_tol: float = 1e-3
+) -> dict[str, str]:
+    """Parameters of a point that sit on a bound of the box.
+
+    Parameters
+    ----------
+    theta : mapping of str to float
+        The point, per parameter name (SI units).
+    box : ParameterBox
+        The box; parameters with a single value are never reported.
+    rel_tol : float
+        Distance from a bound, as a fraction of the parameter's range, that counts as on it.
+
+    Returns
+    -------
+    dict[str, str]
+        Name -> "lower" or "upper", in the box's order.
+    """
+    out: dict[str, str] = {}
+    for name, (lo, hi) in box.bounds.items():
+        span = hi - lo
+        if span <= 0.0 or name not in theta:
+            continue
+        if theta[name] <= lo + rel_tol * span:
+            out[name] = "lower"
+        elif theta[name] >= hi - rel_tol * span:
+            out[name] = "upper"
+    return out
+
+
+def describe_pinned(pinned: Mapping[str, str], box: ParameterBox) -> str:
+    """One sentence on the parameters of theta* that sit on a bound of the box."""
+    parts = [
+        f"{name} at its {side} bound {box.bounds[name][0 if side == 'lower' else 1]:g}"
+        for name, side in pinned.items()
+    ]
+    return (
+        "theta* sits on the boundary of the parameter box (" + ", ".join(parts) + "): the best "
+        "fit may lie outside it. Widen the box where such values are physical; where they are "
+        "not, these parameters are standing in for an effect the model lacks."
+    )
 
 
 def find(
@@ -440,7 +491,11 @@ def find(
     obs["z_at_best"] = (at_best - y) / sigma
     best = BestFit(dict(zip(box.names, map(float, theta), strict=True)), value, at_best)
     gap = math.sqrt(value / len(obs))
-    return FindResult(obs, best, gap, gap_threshold, describe_disagreement(obs, fit_z))
+    pinned = pinned_parameters(best.theta, box)
+    sentences = describe_disagreement(obs, fit_z)
+    if pinned:
+        sentences.append(describe_pinned(pinned, box))
+    return FindResult(obs, best, gap, gap_threshold, sentences, pinned)
 
 
 def format_stress(stress: float) -> str:

@@ -346,6 +346,7 @@ def find_record(result: FindResult, box: ParameterBox, config: Mapping[str, Any]
         "point": base_point(result.best.theta, config),
         "bounds": {k: list(v) for k, v in box.bounds.items()},
         "sentences": result.sentences,
+        "pinned": result.pinned,
     }
 
 

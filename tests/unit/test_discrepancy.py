@@ -15,6 +15,7 @@ from demcal.discrepancy import (
     format_stress,
     minimise_chi2,
     observation_table,
+    pinned_parameters,
 )
 from demcal.experiments import Experiment
 
@@ -119,6 +120,33 @@ def test_find_recovers_the_truth_and_says_nothing_is_missing():
     assert result.gap < 0.05
     assert not result.missing and "nothing missing" in result.verdict
     assert all(" fits at " in s for s in result.sentences)
+
+
+def test_find_inside_the_box_pins_nothing():
+    result = find(model_for(experiment(0.37, 2890.0)), BOX, 31, gap_threshold=1.5)
+    assert result.pinned == {}
+    assert "boundary" not in result.verdict
+
+
+def test_find_flags_a_best_fit_on_the_box_boundary():
+    # The material's density, 3 800 kg/m^3, lies above the box (2 500-3 500): the fit stops
+    # at the upper bound and can still look like noise when the bulk densities are uncertain.
+    exp = experiment(0.37, 3800.0)
+    result = find(model_for(exp), BOX, 31, gap_threshold=1e3)
+    assert result.best.theta["density"] == pytest.approx(3500.0)
+    assert result.pinned == {"density": "upper"}
+    assert not result.missing
+    assert "nothing missing, but theta* sits on the box boundary (density)" in result.verdict
+    assert (
+        "theta* sits on the boundary of the parameter box (density at its upper bound 3500)"
+        in result.sentences[-1]
+    )
+
+
+def test_pinned_parameters_tolerance_and_single_valued_axes():
+    box = ParameterBox({"a": (0.0, 1.0), "b": (5.0, 5.0), "c": (10.0, 20.0)})
+    assert pinned_parameters({"a": 0.0005, "b": 5.0, "c": 15.0}, box) == {"a": "lower"}
+    assert pinned_parameters({"a": 0.002, "b": 5.0, "c": 19.995}, box) == {"c": "upper"}
 
 
 def test_find_matches_brute_force_over_the_grid():
