@@ -226,8 +226,9 @@ class ComposedModel final : public ContactModel {
 #pragma omp barrier
         for (std::size_t i = own.begin; i < own.end; ++i) {
           Vec3 fs, ts;
-          for (int th = 1; th < team; ++th) {
-            if (i < a.list.partition().share(n, th, team).begin || i >= touched_end[th]) continue;
+          // Shares are ordered: only threads up to this one start at or before i.
+          for (int th = 1; th <= tid; ++th) {
+            if (i >= touched_end[static_cast<std::size_t>(th)]) continue;
             fs += a.thread_force[th][i];
             ts += a.thread_torque[th][i];
           }
