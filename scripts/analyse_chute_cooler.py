@@ -3,10 +3,15 @@
 import json
 from pathlib import Path
 
-from demcal.chute_cooler_analysis import analyse_run, index_summary, read_system_table, write_json
-from demcal.chute_cooler_figures import plot_steady_state
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
+from demcal.application.chute_cooler.analysis import (
+    analyse_run,
+    index_summary,
+    read_system_table,
+    write_json,
+)
+from demcal.application.chute_cooler.figures import plot_steady_state
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
 
 
 def main(status: str, outputs: dict, config: dict, log: str) -> None:

@@ -4,11 +4,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from demcal.chute_cooler_analysis import export_paraview, render_layout
-from demcal.chute_cooler_deck import load_case
-from demcal.chute_cooler_figures import plot_fig11
-from demcal.rule_log import rule_log
-from demcal.segregation import segregation_index, table_volumes
+from demcal.application.chute_cooler.analysis import export_paraview, render_layout
+from demcal.application.chute_cooler.deck import load_case
+from demcal.application.chute_cooler.figures import plot_fig11
+from demcal.application.chute_cooler.segregation import segregation_index, table_volumes
+from demcal.core.rule_log import rule_log
 
 
 def main(inputs: dict, outputs: dict, log: str) -> None:

@@ -2,9 +2,9 @@
 
 import pandas as pd
 
-from demcal.dataset import collect
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
+from demcal.bulk.dataset import collect
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
 
 
 def main(inputs: list[str], dataset: str, failed: str, config: dict, log: str) -> None:

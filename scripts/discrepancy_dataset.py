@@ -5,10 +5,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from demcal.discrepancy_extension import extended_training_data, read_runs
-from demcal.discrepancy_runs import candidate_by_name
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+from demcal.discrepancy.extension import extended_training_data, read_runs
+from demcal.discrepancy.runs import candidate_by_name
 
 
 def main(sm) -> None:

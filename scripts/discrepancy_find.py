@@ -3,11 +3,11 @@
 import json
 from pathlib import Path
 
-from demcal.discrepancy_report import find_markdown
-from demcal.discrepancy_workflow import find_from_files, find_record
-from demcal.experiments import load_experiment
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
+from demcal.core.experiments import load_experiment
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+from demcal.discrepancy.report import find_markdown
+from demcal.discrepancy.workflow import find_from_files, find_record
 
 
 def main(sm) -> None:

@@ -6,13 +6,13 @@ from pathlib import Path
 
 import pandas as pd
 
-from demcal.discrepancy_candidates import extended_design
-from demcal.discrepancy_extension import read_runs
-from demcal.discrepancy_report import ranking_markdown
-from demcal.discrepancy_workflow import rank
-from demcal.experiments import load_experiment
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
+from demcal.core.experiments import load_experiment
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+from demcal.discrepancy.candidates import extended_design
+from demcal.discrepancy.extension import read_runs
+from demcal.discrepancy.report import ranking_markdown
+from demcal.discrepancy.workflow import rank
 
 
 def main(sm) -> None:

@@ -3,12 +3,12 @@
 import json
 from pathlib import Path
 
-from demcal.discrepancy_report import find_markdown
-from demcal.discrepancy_runs import candidate_by_name
-from demcal.discrepancy_workflow import recalibrate
-from demcal.experiments import load_experiment
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
+from demcal.core.experiments import load_experiment
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+from demcal.discrepancy.report import find_markdown
+from demcal.discrepancy.runs import candidate_by_name
+from demcal.discrepancy.workflow import recalibrate
 
 
 def main(sm) -> None:

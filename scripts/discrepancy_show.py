@@ -5,11 +5,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from demcal.discrepancy_extension import read_runs
-from demcal.discrepancy_report import gap_figure, verification_markdown
-from demcal.discrepancy_workflow import show
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+from demcal.discrepancy.extension import read_runs
+from demcal.discrepancy.report import gap_figure, verification_markdown
+from demcal.discrepancy.workflow import show
 
 
 def main(sm) -> None:

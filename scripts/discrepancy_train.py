@@ -5,9 +5,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from demcal.discrepancy_extension import train_extended_surrogate
-from demcal.discrepancy_runs import candidate_by_name
-from demcal.rule_log import rule_log
+from demcal.core.rule_log import rule_log
+from demcal.discrepancy.extension import train_extended_surrogate
+from demcal.discrepancy.runs import candidate_by_name
 
 
 def main(sm) -> None:

@@ -13,7 +13,7 @@ Usage: python scripts/hidden_effect_study.py --profile config/config.yaml \\
 
 import argparse
 
-from demcal.discrepancy_synthetic import prepare_study
+from demcal.discrepancy.synthetic import prepare_study
 
 
 def main() -> None:

@@ -3,14 +3,14 @@
 import json
 from pathlib import Path
 
-from demcal.calibration import calibrate, write_valid_sets
-from demcal.experiments import load_experiment
-from demcal.identification import table5_markdown, write_table5_csv
-from demcal.identification_figures import box_plot_normalised, cor_density_plot, note_figure
-from demcal.material_block import material_block_text
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
-from demcal.training import load_surrogate
+from demcal.core.experiments import load_experiment
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+from demcal.decks.material_block import material_block_text
+from demcal.identification.calibration import calibrate, write_valid_sets
+from demcal.identification.figures import box_plot_normalised, cor_density_plot, note_figure
+from demcal.identification.statistics import table5_markdown, write_table5_csv
+from demcal.surrogates.training import load_surrogate
 
 
 def main(sm) -> None:

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import yaml
 
-from demcal.config import load_config
-from demcal.synthetic_experiment import experiment_record, simulate_reference
+from demcal.bulk.synthetic import experiment_record, simulate_reference
+from demcal.core.config import load_config
 
 
 def main() -> None:

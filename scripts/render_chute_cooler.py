@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from demcal.chute_cooler_deck import read_identified_parameters, render_chute_cooler
-from demcal.rule_log import rule_log
+from demcal.application.chute_cooler.deck import read_identified_parameters, render_chute_cooler
+from demcal.core.rule_log import rule_log
 
 
 def main(config: dict, params_file: str | None, deck: str, log: str) -> None:

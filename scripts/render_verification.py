@@ -3,9 +3,9 @@
 import json
 from pathlib import Path
 
-from demcal.cases import verification_case
-from demcal.decks import render_case
-from demcal.rule_log import rule_log
+from demcal.core.rule_log import rule_log
+from demcal.decks.render import render_case
+from demcal.design.cases import verification_case
 
 
 def main(sm) -> None:

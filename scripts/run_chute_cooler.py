@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from demcal.dem_run import run_deck
-from demcal.rule_log import rule_log
+from demcal.core.rule_log import rule_log
+from demcal.engine_io.run import run_deck
 
 
 def main(deck: str, command: str, threads: int, log: str) -> None:

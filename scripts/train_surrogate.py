@@ -4,9 +4,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
-from demcal.training import train_output
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+from demcal.surrogates.training import train_output
 
 
 def main(dataset: str, output: str, settings: dict, model: str, config: dict, log: str) -> None:

@@ -2,9 +2,9 @@
 
 import pandas as pd
 
-from demcal.experiments import load_experiment
-from demcal.rule_log import rule_log
-from demcal.verification import verification_table
+from demcal.core.experiments import load_experiment
+from demcal.core.rule_log import rule_log
+from demcal.identification.verification import verification_table
 
 
 def main(sm) -> None:

@@ -2,10 +2,10 @@
 
 from pathlib import Path
 
-from demcal.cases import design_from_config
-from demcal.design import write_design_table
-from demcal.provenance import write_sidecar
-from demcal.rule_log import rule_log
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+from demcal.design.cases import design_from_config
+from demcal.design.table import write_design_table
 
 
 def main(config: dict, output: str, log: str) -> None:

@@ -2,9 +2,9 @@
 
 import pandas as pd
 
-from demcal.regression_metrics import to_markdown
-from demcal.rule_log import rule_log
-from demcal.surrogate import select_by_test_r2, select_by_validation
+from demcal.core.rule_log import rule_log
+from demcal.surrogates.metrics import to_markdown
+from demcal.surrogates.network import select_by_test_r2, select_by_validation
 
 
 def main(outputs: list[str], tables: list[str], sweeps: list[str], markdown: str, log: str) -> None:

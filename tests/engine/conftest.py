@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from demcal.engine_output import read_log
+from demcal.engine_io.output import read_log
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -9,9 +9,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.chute_cooler_deck import load_case
-from demcal.config import load_config
-from demcal.engine_output import read_dump, read_print_file
+from demcal.application.chute_cooler.deck import load_case
+from demcal.core.config import load_config
+from demcal.engine_io.output import read_dump, read_print_file
 
 from .conftest import engine_path
 

@@ -1,7 +1,8 @@
 """The virtual bulk tests on the tiny profile with the real engine: physical trends, the bulk
 value readout, the pictures, and cycles in one deck against separate runs.
 
-Every case is rendered with :func:`demcal.decks.render_case` from ``config/tiny.yaml`` and run by
+Every case is rendered with :func:`demcal.decks.render.render_case` from ``config/tiny.yaml`` and
+run by
 the engine binary (``DEM_ENGINE``, else the installed or built one), two runs at a time. Runs
 are deterministic (one thread, fixed seeds), so the margins below guard against changes of the
 engine or the set-up, not against chance.
@@ -21,9 +22,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.bulk_values import extract
-from demcal.config import load_config
-from demcal.decks import DECK_NAMES, render_case
+from demcal.bulk.values import extract
+from demcal.core.config import load_config
+from demcal.decks.render import DECK_NAMES, render_case
 from tests.engine.conftest import engine_path
 
 pytestmark = pytest.mark.engine
@@ -179,7 +180,7 @@ def test_load_condition_and_flags_in_the_table(runs: dict[str, Path]) -> None:
 
 
 def test_pictures_are_written(runs: dict[str, Path], tmp_path: Path) -> None:
-    from demcal.pictures import heap_picture, shear_cell_picture
+    from demcal.virtual_tests.pictures import heap_picture, shear_cell_picture
 
     heap = heap_picture(runs["aor_base"], tmp_path / "heap.png")
     cell = shear_cell_picture(runs["shear_seed7"], tmp_path / "cell.png")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from demcal.acceptance import (
+from demcal.identification.acceptance import (
     MeasuredCondition,
     marked_then_valid,
     relative_deviation,

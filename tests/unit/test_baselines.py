@@ -1,4 +1,5 @@
-"""Tests of demcal.baselines: coefficient recovery, GP against linear, ARD, sklearn conventions."""
+"""Tests of demcal.surrogates.baselines: coefficient recovery, GP against linear, ARD, sklearn
+conventions."""
 
 from __future__ import annotations
 
@@ -10,13 +11,13 @@ import pytest
 from sklearn.utils.estimator_checks import parametrize_with_checks
 from threadpoolctl import threadpool_limits
 
-from demcal.baselines import (
+from demcal.surrogates.baselines import (
     AnisotropicGaussianProcess,
     bayesian_linear_regression,
     gaussian_process_regression,
     linear_coefficients,
 )
-from demcal.regression_metrics import regression_metrics
+from demcal.surrogates.metrics import regression_metrics
 
 
 @pytest.fixture(autouse=True)

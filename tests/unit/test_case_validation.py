@@ -1,4 +1,4 @@
-"""Tests of demcal.case_validation: limits, messages, all-at-once reports, missing columns."""
+"""Tests of demcal.decks.case_validation: limits, messages, all-at-once reports, missing columns."""
 
 from __future__ import annotations
 
@@ -7,14 +7,14 @@ from collections.abc import Mapping
 import pandas as pd
 import pytest
 
-from demcal.case_validation import (
+from demcal.decks.case_validation import (
     CaseValidationError,
     MissingColumnError,
     ValidationRules,
     validate_case,
     validate_design,
 )
-from demcal.design import PAPER_TABLE2_LEVELS, expand_load_conditions, factorial_design
+from demcal.design.table import PAPER_TABLE2_LEVELS, expand_load_conditions, factorial_design
 
 GOOD = {
     "case_id": "c0007",

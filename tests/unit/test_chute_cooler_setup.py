@@ -7,14 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from demcal.chute_cooler_deck import (
+from demcal.application.chute_cooler.deck import (
     DECK_NAME,
     IdentifiedParametersError,
     application_distribution,
     read_identified_parameters,
     render_chute_cooler,
 )
-from demcal.chute_cooler_setup import (
+from demcal.application.chute_cooler.setup import (
     ChuteCoolerSetup,
     application_parameters,
     box_row_triangles,
@@ -24,9 +24,9 @@ from demcal.chute_cooler_setup import (
     perforated_plate,
     stream_estimate,
 )
-from demcal.config import load_config, validate_config
-from demcal.shear_cell_setup import GRAVITY, SetupError, material_setup
-from demcal.stl_mesh import read_stl, surface_area, triangle_areas, triangle_normals
+from demcal.core.config import load_config, validate_config
+from demcal.decks.stl_mesh import read_stl, surface_area, triangle_areas, triangle_normals
+from demcal.virtual_tests.shear_cell.setup import GRAVITY, SetupError, material_setup
 
 ROOT = Path(__file__).resolve().parents[2]
 PARAMS = {
@@ -245,7 +245,7 @@ def test_parameters_explicit_identified_or_error():
 
 
 def test_read_identified_parameters(tmp_path):
-    # The record as the identification writes it (demcal.calibration).
+    # The record as the identification writes it (demcal.identification.calibration).
     good = tmp_path / "p.json"
     stats = {"mean": 2900.0, "sd": 10.0, "min": 2800, "max": 3000}
     good.write_text(

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from demcal.config import ConfigError, load_config, load_schema, validate_config
+from demcal.core.config import ConfigError, load_config, load_schema, validate_config
 
 ROOT = Path(__file__).resolve().parents[2]
 

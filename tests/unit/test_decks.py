@@ -12,11 +12,11 @@ import jinja2
 import numpy as np
 import pytest
 
-from demcal.bulk_values import MissingOutputError, extract
-from demcal.case_validation import CaseValidationError, MissingColumnError
-from demcal.config import load_config, validate_config
-from demcal.decks import format_number, render_case, template_environment
-from demcal.stl_mesh import read_stl, surface_area
+from demcal.bulk.values import MissingOutputError, extract
+from demcal.core.config import load_config, validate_config
+from demcal.decks.case_validation import CaseValidationError, MissingColumnError
+from demcal.decks.render import format_number, render_case, template_environment
+from demcal.decks.stl_mesh import read_stl, surface_area
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -1,4 +1,4 @@
-"""Tests of demcal.design: factorial and sampled designs, load conditions, table files."""
+"""Tests of demcal.design.table: factorial and sampled designs, load conditions, table files."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.design import (
+from demcal.design.table import (
     PAPER_TABLE2_LEVELS,
     DesignSpecError,
     DesignTableError,

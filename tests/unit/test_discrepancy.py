@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.acceptance import MeasuredCondition
-from demcal.discrepancy import (
+from demcal.core.experiments import Experiment
+from demcal.discrepancy.find import (
     ParameterBox,
     SurrogateModel,
     describe_disagreement,
@@ -17,7 +17,7 @@ from demcal.discrepancy import (
     observation_table,
     pinned_parameters,
 )
-from demcal.experiments import Experiment
+from demcal.identification.acceptance import MeasuredCondition
 
 FEATURES = ["coefficientFriction", "density", "normal_stress", "P"]
 STRESSES = (1068.0, 2029.0, 10070.0)

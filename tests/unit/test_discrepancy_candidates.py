@@ -5,9 +5,9 @@ from pathlib import Path
 
 import pytest
 
-from demcal.acceptance import MeasuredCondition
-from demcal.config import load_config
-from demcal.discrepancy_candidates import (
+from demcal.core.config import load_config
+from demcal.core.experiments import Experiment
+from demcal.discrepancy.candidates import (
     applicability,
     base_point,
     candidate_config,
@@ -18,9 +18,9 @@ from demcal.discrepancy_candidates import (
     probe_runs,
     run_suffixes,
 )
-from demcal.discrepancy_plan import DiscrepancyPlan
-from demcal.discrepancy_synthetic import study_config
-from demcal.experiments import Experiment
+from demcal.discrepancy.plan import DiscrepancyPlan
+from demcal.discrepancy.synthetic import study_config
+from demcal.identification.acceptance import MeasuredCondition
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -7,17 +7,17 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.discrepancy_candidates import Candidate
-from demcal.discrepancy_extension import (
+from demcal.discrepancy.candidates import Candidate
+from demcal.discrepancy.extension import (
     extended_training_data,
     read_runs,
     rmse_of,
     train_extended_surrogate,
 )
-from demcal.discrepancy_report import gap_figure, gap_of, gap_table, markdown_table
-from demcal.discrepancy_synthetic import replicate_record
-from demcal.discrepancy_workflow import run_values
-from demcal.training import load_surrogate
+from demcal.discrepancy.report import gap_figure, gap_of, gap_table, markdown_table
+from demcal.discrepancy.synthetic import replicate_record
+from demcal.discrepancy.workflow import run_values
+from demcal.surrogates.training import load_surrogate
 
 COHESION = Candidate(
     "cohesion", "d", {}, "cohesionEnergyDensity", None, 0.0, (0.0, 5e4), (4e4,), False

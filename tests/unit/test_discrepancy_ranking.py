@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from demcal.acceptance import MeasuredCondition
-from demcal.discrepancy import ParameterBox, SurrogateModel, find, observation_table
-from demcal.discrepancy_ranking import (
+from demcal.core.experiments import Experiment
+from demcal.discrepancy.find import ParameterBox, SurrogateModel, find, observation_table
+from demcal.discrepancy.ranking import (
     EffectResponse,
     fit_candidate,
     null_fit,
@@ -15,7 +15,7 @@ from demcal.discrepancy_ranking import (
     ranking_sigma,
     response_signature,
 )
-from demcal.experiments import Experiment
+from demcal.identification.acceptance import MeasuredCondition
 
 FEATURES = ["coefficientFriction", "density", "normal_stress", "P"]
 STRESSES = (1068.0, 2029.0, 10070.0)

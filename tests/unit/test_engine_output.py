@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.engine_output import (
+from demcal.engine_io.output import (
     EngineOutputError,
     MissingColumnError,
     TruncatedOutputWarning,

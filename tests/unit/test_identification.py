@@ -10,7 +10,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.identification import (
+from demcal.identification.figures import box_plot_normalised, cor_density_plot
+from demcal.identification.statistics import (
     combine_statistics,
     dominant_bin_map,
     identified_parameters,
@@ -20,7 +21,6 @@ from demcal.identification import (
     write_table5_csv,
     write_table5_markdown,
 )
-from demcal.identification_figures import box_plot_normalised, cor_density_plot
 
 RANGES = {
     "coefficientFriction": (0.1, 1.0),

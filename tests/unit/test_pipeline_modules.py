@@ -9,14 +9,14 @@ import pytest
 import torch
 import yaml
 
-from demcal.acceptance import MeasuredCondition
-from demcal.calibration import ConstantInputs, calibrate
-from demcal.cases import case_ids, case_row, design_from_config, verification_case
-from demcal.config import ConfigError, validate_config
-from demcal.dataset import case_rows, collect, usable
-from demcal.dem_run import engine_command, run_deck
-from demcal.experiments import Experiment, load_experiment
-from demcal.verification import verification_table
+from demcal.bulk.dataset import case_rows, collect, usable
+from demcal.core.config import ConfigError, validate_config
+from demcal.core.experiments import Experiment, load_experiment
+from demcal.design.cases import case_ids, case_row, design_from_config, verification_case
+from demcal.engine_io.run import engine_command, run_deck
+from demcal.identification.acceptance import MeasuredCondition
+from demcal.identification.calibration import ConstantInputs, calibrate
+from demcal.identification.verification import verification_table
 from tests.engine.conftest import engine_path
 
 

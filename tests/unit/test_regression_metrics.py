@@ -1,4 +1,4 @@
-"""Tests of demcal.regression_metrics: hand-computed cases, sklearn equivalence, tables."""
+"""Tests of demcal.surrogates.metrics: hand-computed cases, sklearn equivalence, tables."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from sklearn.metrics import mean_absolute_error, mean_squared_error, r2_score
 
-from demcal.regression_metrics import method_comparison_table, regression_metrics, to_markdown
+from demcal.surrogates.metrics import method_comparison_table, regression_metrics, to_markdown
 
 
 def test_hand_computed_case() -> None:

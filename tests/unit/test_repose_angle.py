@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from demcal.repose_angle import angle_of_repose
+from demcal.virtual_tests.angle_of_repose.readout import angle_of_repose
 
 R_MIN, R_MAX = 0.35e-3, 0.8e-3  # particle radii, m (sinter-fines range)
 HEIGHTS = {25.0: 0.016, 35.0: 0.020, 45.0: 0.024}  # heap height per angle, m

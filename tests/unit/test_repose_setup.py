@@ -6,9 +6,9 @@ import math
 
 import pytest
 
-from demcal.config import validate_config
-from demcal.repose_setup import lift_froude_number, repose_setup
-from demcal.shear_cell_setup import SetupError, material_setup, size_distribution
+from demcal.core.config import validate_config
+from demcal.virtual_tests.angle_of_repose.setup import lift_froude_number, repose_setup
+from demcal.virtual_tests.shear_cell.setup import SetupError, material_setup, size_distribution
 
 CASE = {
     "case_id": "c0002",

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import torch
 
-from demcal.acceptance import MeasuredCondition
-from demcal.screening import (
+from demcal.identification.acceptance import MeasuredCondition
+from demcal.identification.screening import (
     REPOSE_FEATURES,
     SHEAR_FEATURES,
     TABLE3_SPEC,

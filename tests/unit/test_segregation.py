@@ -6,7 +6,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.segregation import (
+from demcal.application.chute_cooler.segregation import (
     LAYERS,
     Box,
     analyse_segregation,

@@ -8,8 +8,9 @@ import math
 
 import pytest
 
-from demcal.config import validate_config
-from demcal.shear_cell_setup import (
+from demcal.core.config import validate_config
+from demcal.particles.size_distribution import monodisperse, sinter_fines
+from demcal.virtual_tests.shear_cell.setup import (
     SetupError,
     inertial_number,
     material_setup,
@@ -22,7 +23,6 @@ from demcal.shear_cell_setup import (
     steps_for,
     time_step,
 )
-from demcal.size_distribution import monodisperse, sinter_fines
 
 CASE = {
     "case_id": "c0001",

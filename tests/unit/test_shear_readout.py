@@ -8,8 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.engine_output import MissingColumnError, read_print_file
-from demcal.shear_readout import (
+from demcal.engine_io.output import MissingColumnError, read_print_file
+from demcal.virtual_tests.shear_cell.readout import (
     REQUIRED_COLUMNS,
     overlap_area,
     shear_cell_bulk_values,

@@ -1,4 +1,5 @@
-"""Tests of demcal.size_distribution: sieve classes, number fractions, statistics, scaling."""
+"""Tests of demcal.particles.size_distribution: sieve classes, number fractions, statistics,
+scaling."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from demcal.size_distribution import (
+from demcal.particles.size_distribution import (
     SINTER_FINES_SIEVE_MM,
     SizeDistribution,
     from_sieve_analysis,

@@ -1,4 +1,4 @@
-"""Tests of demcal.stl_mesh: surface areas, closedness, orientation, STL round trips."""
+"""Tests of demcal.decks.stl_mesh: surface areas, closedness, orientation, STL round trips."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from demcal.stl_mesh import (
+from demcal.decks.stl_mesh import (
     StlFormatError,
     annulus,
     box_open_top,

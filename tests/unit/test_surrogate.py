@@ -1,4 +1,5 @@
-"""Tests of demcal.surrogate (split, MLP, persistence, sweep) and demcal.surrogate_figures."""
+"""Tests of demcal.surrogates.network (split, MLP, persistence, sweep) and
+demcal.surrogates.figures."""
 
 from __future__ import annotations
 
@@ -14,9 +15,9 @@ import torch
 from sklearn.utils.estimator_checks import parametrize_with_checks
 from threadpoolctl import threadpool_limits
 
-from demcal.regression_metrics import regression_metrics
-from demcal.surrogate import MLPSurrogate, split_indices, sweep_hidden_sizes
-from demcal.surrogate_figures import parity_plot, r2_vs_hidden_size
+from demcal.surrogates.figures import parity_plot, r2_vs_hidden_size
+from demcal.surrogates.metrics import regression_metrics
+from demcal.surrogates.network import MLPSurrogate, split_indices, sweep_hidden_sizes
 
 FEATURES = [
     "coefficientFriction",
@@ -276,7 +277,7 @@ def test_r2_vs_hidden_size_writes_png(tmp_path: Path) -> None:
 
 
 def test_split_groups_keeps_groups_together():
-    from demcal.surrogate import split_groups
+    from demcal.surrogates.network import split_groups
 
     groups = np.repeat([f"c{k:04d}" for k in range(20)], 4)  # 20 parameter sets x 4 loads
     train, val, test = split_groups(groups, seed=3)

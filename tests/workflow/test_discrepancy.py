@@ -17,8 +17,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from demcal.config import validate_config
-from demcal.discrepancy_synthetic import study_config, write_hidden_effect_experiment
+from demcal.core.config import validate_config
+from demcal.discrepancy.synthetic import study_config, write_hidden_effect_experiment
 
 ROOT = Path(__file__).resolve().parents[2]
 TRUTH = ROOT / "config" / "experiments" / "truth"

@@ -1,6 +1,6 @@
 # Shared set-up: validated configuration, the case list and output locations.
-from demcal.cases import TESTS, case_ids, case_row, design_from_config, verification_case_ids
-from demcal.config import validate_config
+from demcal.design.cases import TESTS, case_ids, case_row, design_from_config, verification_case_ids
+from demcal.core.config import validate_config
 
 validate_config(config, source=", ".join(str(f) for f in workflow.configfiles) or "config")
 

@@ -3,8 +3,8 @@
 # model (extended design, new surrogates, recalibration) and show the gap before and after.
 # Target: `snakemake --cores 2 discrepancy`. If nothing is missing it stops after Find.
 
-from demcal.discrepancy_plan import DiscrepancyPlan
-from demcal.discrepancy_runs import render_discrepancy_run
+from demcal.discrepancy.plan import DiscrepancyPlan
+from demcal.discrepancy.runs import render_discrepancy_run
 
 DISC = f"{RESULTS}/discrepancy"
 DISC_PLAN = DiscrepancyPlan.from_config(config, RESULTS)

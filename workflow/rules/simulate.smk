@@ -2,9 +2,9 @@
 # values.
 from pathlib import Path
 
-from demcal.dataset import write_case_rows
-from demcal.decks import render_case
-from demcal.rule_log import rule_log
+from demcal.bulk.dataset import write_case_rows
+from demcal.decks.render import render_case
+from demcal.core.rule_log import rule_log
 
 
 rule render_case:

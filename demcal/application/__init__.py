@@ -1,0 +1,2 @@
+"""Industrial applications of an identified parameter set.
+"""

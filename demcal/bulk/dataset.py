@@ -1,0 +1,116 @@
+"""The tidy bulk dataset: one row per DEM case and load condition, inputs, outputs and flags."""
+
+import json
+import math
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from demcal.bulk.values import extract
+from demcal.core.provenance import write_sidecar
+from demcal.core.rule_log import rule_log
+
+#: Contact and geometry parameters a case may carry (LIGGGHTS names).
+PARAMETERS = (
+    "coefficientFriction",
+    "coefficientRollingFriction",
+    "coefficientRestitution",
+    "density",
+    "cohesionEnergyDensity",
+    "wallFriction",
+    "dCylDp",
+)
+#: Bulk values per test.
+OUTPUTS = {"shear_cell": ("mu_psh", "mu_sh", "rho_b"), "angle_of_repose": ("aor",)}
+
+
+def case_rows(
+    test: str,
+    case_dir: str | Path,
+    extract: Callable[[str, Path], pd.DataFrame],
+    p_values: Sequence[float],
+) -> pd.DataFrame:
+    """Bulk rows of one case, with its inputs, status and flags.
+
+    A case whose engine run failed gives rows with ``status == "failed"``, empty outputs and the
+    engine's error, one per load condition, so that it is counted and excluded, never lost.
+
+    Parameters
+    ----------
+    test : {"shear_cell", "angle_of_repose"}
+    case_dir : path
+        Directory with ``case.json`` and ``status.json``.
+    extract : callable
+        ``extract(test, case_dir) -> DataFrame`` of bulk values (see ``demcal.bulk.values``).
+    p_values : sequence of float
+        Shear load fractions, for the rows of a failed shear-cell case that ran all P values
+        as cycles (a separate-run case carries its own P).
+    """
+    case_dir = Path(case_dir)
+    info = json.loads((case_dir / "case.json").read_text())
+    status = json.loads((case_dir / "status.json").read_text())
+    case = info["case"]
+    if status["status"] == "ok":
+        try:
+            rows = extract(test, case_dir).copy()
+            status_text, error = "ok", ""
+        except (OSError, ValueError, KeyError) as exc:
+            rows, status_text, error = None, "failed", f"bulk extraction: {exc}"
+    else:
+        rows, status_text, error = None, "failed", status.get("error", "")
+    if rows is None:
+        # One row per load condition the case was meant to produce.
+        loads = [case["P"]] if "P" in case else list(p_values)
+        n = len(loads) if test == "shear_cell" else 1
+        rows = pd.DataFrame({"case_id": [case["case_id"]] * n})
+        if test == "shear_cell":
+            rows["normal_stress"] = case["normal_stress"]
+            rows["P"] = loads
+        for out in OUTPUTS[test]:
+            rows[out] = math.nan
+    rows["test"] = test
+    rows["case_id"] = case["case_id"]
+    rows["design_id"] = case["case_id"].split("_s")[0]
+    for name in PARAMETERS:
+        if name in case:
+            rows[name] = float(case[name])
+        elif name == "dCylDp":
+            rows[name] = float(info.get("setup", {}).get("dCylDp", math.nan))
+    rows["status"] = status_text
+    rows["error"] = error
+    rows["engine_seconds"] = status.get("seconds", math.nan)
+    return rows
+
+
+def collect(frames: Iterable[pd.DataFrame]) -> pd.DataFrame:
+    """Concatenate per-case rows into the tidy dataset with a stable column order."""
+    data = pd.concat(list(frames), ignore_index=True, sort=False)
+    first = ["test", "case_id", "design_id", *[p for p in PARAMETERS if p in data]]
+    load = [c for c in ("normal_stress", "P") if c in data]
+    outputs = [o for outs in OUTPUTS.values() for o in outs if o in data]
+    rest = [c for c in data.columns if c not in {*first, *load, *outputs}]
+    return data[first + load + outputs + rest]
+
+
+def usable(data: pd.DataFrame, output: str) -> pd.DataFrame:
+    """Rows fit for training on ``output``: the run succeeded and the value is finite."""
+    ok = (data["status"] == "ok") & data[output].notna()
+    return data[ok]
+
+
+def write_case_rows(
+    test: str,
+    info: str | Path,
+    p_values: Sequence[float],
+    path: str,
+    config: Mapping[str, Any],
+    log: str,
+) -> None:
+    """Extract the bulk rows of one case (directory of ``info``, see :func:`case_rows`) and
+    write them as CSV with a provenance sidecar (``<path>.json``); logs to ``log``."""
+    with rule_log(log):
+        rows = case_rows(test, Path(info).parent, extract, p_values)
+        rows.to_csv(path, index=False, float_format="%.10g")
+        write_sidecar(path, config, seed=int(config["seed"]), extra={"rows": len(rows)})

@@ -1,0 +1,113 @@
+"""Synthetic "measured" data: the engine run at known parameters, optionally with noise.
+
+The true parameters live in a file that the workflow never reads, so that tests can check that
+the identification recovers them.
+"""
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from demcal.bulk.values import extract
+from demcal.decks.render import render_case
+from demcal.design.cases import load_condition, shear_suffixes
+from demcal.engine_io.run import run_deck
+
+
+def simulate_reference(
+    parameters: Mapping[str, float], config: Mapping[str, Any], work_dir: str | Path
+) -> pd.DataFrame:
+    """Bulk values of both virtual tests at ``parameters`` (tidy rows; raises if a run fails)."""
+    work_dir = Path(work_dir)
+    frames = []
+    cases: list[tuple[str, dict]] = [("angle_of_repose", {"case_id": "reference", **parameters})]
+    for suffix in shear_suffixes(config):
+        key = f"reference{suffix}"
+        cases.append(("shear_cell", {"case_id": key, **parameters, **load_condition(config, key)}))
+    for test, case in cases:
+        frames.append(
+            run_case_bulk(test, case, config, work_dir / test / case["case_id"], "reference run")
+        )
+    return pd.concat(frames, ignore_index=True)
+
+
+def run_case_bulk(
+    test: str,
+    case: Mapping[str, Any],
+    config: Mapping[str, Any],
+    case_dir: Path,
+    label: str,
+) -> pd.DataFrame:
+    """Render, run and read one case: its bulk-value rows with a ``test`` column.
+
+    Raises
+    ------
+    RuntimeError
+        When the engine run fails (the message starts with ``label`` and names ``case_dir``).
+    """
+    info = render_case(test, case, config, case_dir)
+    status = run_deck(
+        case_dir,
+        Path(info["deck"]).name,
+        config["engine"]["command"],
+        int(config["engine"]["threads"]),
+    )
+    if status["status"] != "ok":
+        raise RuntimeError(f"{label} {case_dir} failed: {status['error']}")
+    rows = extract(test, case_dir)
+    rows["test"] = test
+    return rows
+
+
+def experiment_record(
+    bulk: pd.DataFrame,
+    material: str,
+    noise: float,
+    seed: int,
+    source: str,
+    observables: tuple[str, ...] = ("mu_psh", "mu_sh", "rho_b"),
+    p_values: tuple[float, ...] | None = None,
+) -> dict[str, Any]:
+    """An experiment-file mapping from reference bulk values, with relative Gaussian noise.
+
+    Parameters
+    ----------
+    bulk : DataFrame
+        Output of :func:`simulate_reference`.
+    noise : float
+        Relative standard deviation of the measurement noise (e.g. 0.01), also written as sd.
+    observables : tuple of str
+        Shear-cell readings to keep (partial data, as a real test may give).
+    p_values : tuple of float, optional
+        Shear load fractions to keep; all when None.
+    """
+    rng = np.random.default_rng(seed)
+
+    def noisy(value: float) -> float:
+        return float(value * (1.0 + noise * rng.standard_normal())) if noise > 0 else float(value)
+
+    record: dict[str, Any] = {"material": material, "source": source}
+    aor = bulk[bulk["test"] == "angle_of_repose"]
+    if len(aor) and np.isfinite(aor["aor"].iloc[0]):
+        value = float(aor["aor"].iloc[0])
+        record["angle_of_repose"] = {"value": round(noisy(value), 4), "sd": round(noise * value, 4)}
+    conditions = []
+    shear = bulk[bulk["test"] == "shear_cell"]
+    if p_values is not None:
+        shear = shear[shear["P"].round(6).isin([round(p, 6) for p in p_values])]
+    for _, row in shear.sort_values(["normal_stress", "P"]).iterrows():
+        entry: dict[str, float] = {
+            "normal_stress": float(row["normal_stress"]),
+            "P": float(row["P"]),
+        }
+        for name in observables:
+            if np.isfinite(row[name]):
+                entry[name] = round(noisy(float(row[name])), 6)
+                entry[f"{name}_sd"] = round(noise * float(row[name]), 6)
+        conditions.append(entry)
+    if conditions:
+        record["shear_cell"] = conditions
+    return record

@@ -1,0 +1,121 @@
+"""The DEM cases of a study: design rows expanded to one case per virtual test run.
+
+A shear-cell case is a design row at one pre-shear normal stress and, by default, one shear
+load P (``c0003_s2_p1``); with ``shear_cell.separate_runs: false`` all P values run as cycles
+in one deck (``c0003_s2``). An angle-of-repose case is a design row (``c0003``). Wildcards
+carry these ids, never floats.
+"""
+
+import re
+from collections.abc import Mapping
+from typing import Any
+
+import pandas as pd
+
+from demcal.design.table import build_design
+
+TESTS = ("shear_cell", "angle_of_repose")
+_SHEAR_KEY = re.compile(r"[A-Za-z0-9]+_s(?P<s>\d+)(_p(?P<p>\d+))?")
+
+# Keys of the design config section that each kind of design reads.
+_KEYS_BY_KIND = {
+    "factorial": ("kind", "levels", "fixed"),
+    "random": ("kind", "n", "seed", "ranges", "choices", "fixed"),
+    "lhs": ("kind", "n", "seed", "ranges", "choices", "fixed"),
+    "sobol": ("kind", "n", "seed", "ranges", "choices", "fixed"),
+}
+
+
+def design_spec(section: Mapping[str, Any]) -> dict[str, Any]:
+    """Reduce the validated ``design`` config section to the keys its kind uses."""
+    keys = _KEYS_BY_KIND[section["kind"]]
+    return {k: section[k] for k in keys if k in section and section[k] != {}}
+
+
+def design_from_config(config: Mapping[str, Any]) -> pd.DataFrame:
+    """The design table (one row per parameter set) of a validated configuration."""
+    return build_design(design_spec(config["design"]))
+
+
+def case_ids(config: Mapping[str, Any], design: pd.DataFrame, test: str) -> list[str]:
+    """Ids of the DEM cases of one test.
+
+    Shear-cell cases run one pre-shear stress (``_s<k>``) and, with
+    ``shear_cell.separate_runs``, one shear load P per deck (``_p<j>``); otherwise all P
+    values run as cycles in one deck.
+    """
+    if test == "angle_of_repose":
+        return list(design["case_id"])
+    return [f"{cid}{suffix}" for cid in design["case_id"] for suffix in shear_suffixes(config)]
+
+
+def shear_suffixes(config: Mapping[str, Any]) -> list[str]:
+    """Case-id suffixes of the shear-cell runs of one parameter set."""
+    cell = config["shear_cell"]
+    stresses = range(1, len(cell["normal_stresses"]) + 1)
+    if cell.get("separate_runs", False):
+        return [f"_s{k}_p{j}" for k in stresses for j in range(1, len(cell["P"]) + 1)]
+    return [f"_s{k}" for k in stresses]
+
+
+def load_condition(config: Mapping[str, Any], key: str) -> dict[str, float]:
+    """normal_stress (and P for a separate-run case) encoded in a shear-cell case id."""
+    match = _SHEAR_KEY.fullmatch(key)
+    if match is None:
+        raise KeyError(f"shear-cell case {key!r} has no _s<k> suffix")
+    cell = config["shear_cell"]
+    k = int(match.group("s")) - 1
+    if not 0 <= k < len(cell["normal_stresses"]):
+        raise KeyError(f"case {key!r}: no normal stress number {k + 1}")
+    load = {"normal_stress": float(cell["normal_stresses"][k])}
+    if match.group("p"):
+        j = int(match.group("p")) - 1
+        if not 0 <= j < len(cell["P"]):
+            raise KeyError(f"case {key!r}: no P number {j + 1}")
+        load["P"] = float(cell["P"][j])
+    return load
+
+
+def case_row(config: Mapping[str, Any], design: pd.DataFrame, test: str, key: str) -> dict:
+    """The parameters of one case: its design row, plus the load condition for the shear cell.
+
+    Raises
+    ------
+    KeyError
+        When ``key`` is not a case of the design.
+    """
+    base = key.split("_s")[0]
+    rows = design[design["case_id"] == base]
+    if rows.empty:
+        raise KeyError(f"case {key!r} is not in the design")
+    row = {k: (v.item() if hasattr(v, "item") else v) for k, v in rows.iloc[0].items()}
+    row["case_id"] = key
+    if test == "shear_cell":
+        row.update(load_condition(config, key))
+    return row
+
+
+def verification_case(
+    config: Mapping[str, Any], identified: Mapping[str, Any], test: str, key: str
+) -> dict:
+    """A case at the identified mean parameters (``identified`` or ``identified_s<k>``).
+
+    Raises
+    ------
+    ValueError
+        When no parameter set was identified.
+    """
+    params = identified.get("parameters") or {}
+    if not params:
+        raise ValueError("no parameter set was identified; nothing to verify")
+    row: dict[str, Any] = {"case_id": key, **{k: float(v["mean"]) for k, v in params.items()}}
+    if test == "shear_cell":
+        row.update(load_condition(config, key))
+    return row
+
+
+def verification_case_ids(config: Mapping[str, Any], test: str) -> list[str]:
+    """Ids of the verification runs at the identified set."""
+    if test == "angle_of_repose":
+        return ["identified"]
+    return [f"identified{suffix}" for suffix in shear_suffixes(config)]

@@ -1,0 +1,216 @@
+"""Add the named effect: the extended training data and its surrogates (discrepancy step 3).
+
+The extended model has the candidate's magnitude as one more input. Its training data are the
+runs of the extended design, plus two kinds of runs that already exist and are exact samples of
+the extended model: the current design's runs (the effect absent, i.e. the magnitude at its
+"absent" value) and the probe runs at theta* (the reference and the winner's levels).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import numbers
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from demcal.bulk.dataset import usable
+from demcal.discrepancy.candidates import Candidate
+from demcal.surrogates.metrics import regression_metrics
+from demcal.surrogates.network import split_indices, sweep_hidden_sizes
+from demcal.surrogates.training import INPUTS, TEST_OF, varying_features
+
+__all__ = [
+    "extended_training_data",
+    "read_runs",
+    "train_extended_surrogate",
+]
+
+_TEST_NAMES = {"repose": "angle_of_repose"}
+
+
+def read_runs(bulk_files: Iterable[str | Path]) -> pd.DataFrame:
+    """Bulk rows of discrepancy runs with every numeric and text field of their case row.
+
+    Each ``bulk.csv`` (written by the ``bulk_case`` rule) is joined with the ``case`` entry of
+    the ``case.json`` beside it, so parameters the tidy dataset does not know (a magnitude set
+    through the configuration, the candidate's name) are kept.
+
+    Raises
+    ------
+    FileNotFoundError
+        When a ``case.json`` is missing (names the file).
+    """
+    frames = []
+    for path in bulk_files:
+        path = Path(path)
+        info_path = path.parent / "case.json"
+        if not info_path.is_file():
+            raise FileNotFoundError(f"{info_path}: case description of {path} is missing")
+        case = json.loads(info_path.read_text())["case"]
+        rows = pd.read_csv(path)
+        for key, value in case.items():
+            if key == "case_id" or (key in ("normal_stress", "P") and key in rows):
+                continue
+            if isinstance(value, bool) or not isinstance(value, numbers.Real | str):
+                continue
+            rows[key] = value
+        rows["run"] = path.parent.name
+        rows["test"] = rows["test"].replace(_TEST_NAMES)
+        frames.append(rows)
+    if not frames:
+        return pd.DataFrame()
+    return pd.concat(frames, ignore_index=True, sort=False)
+
+
+def extended_training_data(
+    base: pd.DataFrame,
+    probes: pd.DataFrame,
+    extended: pd.DataFrame,
+    candidate: Candidate,
+    tests: Sequence[str],
+) -> pd.DataFrame:
+    """The training rows of the extended model, with the magnitude column filled everywhere.
+
+    Parameters
+    ----------
+    base : DataFrame
+        The current design's tidy dataset (effect absent).
+    probes : DataFrame
+        Probe runs (:func:`read_runs`); the reference and the candidate's levels are kept.
+    extended : DataFrame
+        Runs of the extended design (:func:`read_runs`).
+    candidate : Candidate
+        The added effect.
+    tests : sequence of str
+        Tests to keep.
+
+    Returns
+    -------
+    DataFrame
+        Rows of all three sources with a ``source`` column (base, probe, extended).
+    """
+    param = candidate.parameter
+
+    def absent(frame: pd.DataFrame) -> pd.Series:
+        if isinstance(candidate.off_value, str):
+            return frame[candidate.off_value].astype(float)
+        return pd.Series(float(candidate.off_value), index=frame.index)
+
+    parts = []
+    if len(base):
+        b = base[base["test"].isin(tests)].copy()
+        b[param] = absent(b)
+        parts.append(b.assign(source="base"))
+    if len(probes):
+        kept = probes[probes["discrepancy_candidate"].isin(["none", candidate.name])].copy()
+        kept = kept[kept["test"].isin(tests)]
+        off = kept["discrepancy_candidate"] == "none"
+        kept.loc[off, param] = absent(kept[off])
+        parts.append(kept.assign(source="probe"))
+    if len(extended):
+        parts.append(extended[extended["test"].isin(tests)].assign(source="extended"))
+    if not parts:
+        raise ValueError("extended model: no training rows")
+    data = pd.concat(parts, ignore_index=True, sort=False)
+    if data[param].isna().any():
+        raise ValueError(f"extended model: rows without a value of {param!r}")
+    return data
+
+
+def train_extended_surrogate(
+    data: pd.DataFrame,
+    output: str,
+    settings: Mapping[str, Any],
+    extra_inputs: Sequence[str],
+    model_path: str | Path,
+) -> dict[str, Any]:
+    """Train the network of one bulk value of the extended model and save it.
+
+    The inputs are those of :data:`demcal.surrogates.training.INPUTS` plus ``extra_inputs`` that
+    vary in
+    the data; the hidden-size sweep, split and selection are those of the main surrogates
+    (the ``surrogate`` config section).
+
+    Returns
+    -------
+    dict
+        The metadata written into the model's sidecar (features, sizes, test metrics).
+
+    Raises
+    ------
+    ValueError
+        When fewer than 6 usable rows exist.
+    """
+    rows = usable(data[data["test"] == TEST_OF[output]], output)
+    if len(rows) < 6:
+        raise ValueError(f"{output}: only {len(rows)} usable runs for the extended model")
+    candidates = list(INPUTS[output]) + [e for e in extra_inputs if e not in INPUTS[output]]
+    features = varying_features(rows, candidates)
+    X = rows[features].to_numpy(dtype=float)
+    y = rows[output].to_numpy(dtype=float)
+    seed = int(settings["seed"])
+    train, val, test = split_indices(len(rows), seed, tuple(settings["split"]))
+    lo, hi = settings["hidden_sizes"]
+    sweep = sweep_hidden_sizes(
+        X,
+        y,
+        train,
+        val,
+        test,
+        sizes=range(int(lo), int(hi) + 1),
+        seed=seed,
+        max_epochs=int(settings["max_epochs"]),
+        patience=int(settings["patience"]),
+    )
+    metrics = regression_metrics(y[test], sweep.model.predict(X[test]))
+    metadata = {
+        "output": output,
+        "features": features,
+        "n_samples": len(rows),
+        "split_sizes": [len(train), len(val), len(test)],
+        "selected_size": int(sweep.selected_size),
+        "test_metrics": {k: float(v) for k, v in metrics.items()},
+        "sources": {str(k): int(v) for k, v in rows["source"].value_counts().items()}
+        if "source" in rows
+        else {},
+    }
+    sweep.model.save(model_path, metadata=metadata)
+    return metadata
+
+
+def rmse_of(model_path: str | Path) -> float:
+    """Held-out RMSE of a saved surrogate: its generalisation and test sets pooled.
+
+    Both sets are left out of the fit; pooling them halves the scatter of the estimate when
+    each holds only a handful of runs (the generalisation set steers early stopping, so the
+    pooled value leans slightly optimistic). Falls back to the test RMSE alone.
+
+    Raises
+    ------
+    KeyError
+        When the sidecar has no test metrics (names the file).
+    ValueError
+        When the RMSE is not finite.
+    """
+    sidecar = Path(f"{model_path}.json")
+    record = json.loads(sidecar.read_text())
+    meta = record.get("metadata", {})
+    try:
+        test_mse = float(meta["test_metrics"]["mse"])
+        n_test = int(meta["split_sizes"][2]) if "split_sizes" in meta else 1
+    except KeyError as exc:
+        raise KeyError(f"{sidecar}: no metadata.test_metrics") from exc
+    training = record.get("training", {})
+    n_val = int(training.get("n_val", 0))
+    val_mse = float(training.get("val_mse", math.nan))
+    if n_val > 0 and math.isfinite(val_mse):
+        value = math.sqrt((n_val * val_mse + n_test * test_mse) / (n_val + n_test))
+    else:
+        value = math.sqrt(test_mse)
+    if not math.isfinite(value):
+        raise ValueError(f"{sidecar}: held-out RMSE is not finite")
+    return value

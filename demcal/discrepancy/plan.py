@@ -1,0 +1,148 @@
+"""Which files the discrepancy workflow needs: the run lists behind its Snakemake rules.
+
+Everything here is known from the configuration and the measured data when the workflow is
+parsed, except what the two checkpoints decide: whether anything is missing (Find) and which
+effect is added (Name). The functions that depend on a checkpoint take its output file.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from demcal.core.experiments import Experiment, load_experiment
+from demcal.discrepancy.candidates import (
+    REFERENCE_CASE,
+    Candidate,
+    applicability,
+    measured_tests,
+    parse_candidates,
+    probe_runs,
+    run_suffixes,
+)
+
+__all__ = ["VERIFICATION_CASE", "DiscrepancyPlan", "measured_observables"]
+
+#: Run id of the verification of the extended model.
+VERIFICATION_CASE = "verify"
+
+
+def measured_observables(experiment: Experiment) -> list[str]:
+    """Bulk values that were measured, in the order mu_psh, mu_sh, rho_b, aor."""
+    seen = {name for cond in experiment.shear_conditions for name in cond.values}
+    if experiment.angle_of_repose is not None:
+        seen.add("aor")
+    return [o for o in ("mu_psh", "mu_sh", "rho_b", "aor") if o in seen]
+
+
+@dataclass(frozen=True)
+class DiscrepancyPlan:
+    """Run lists and file names of one discrepancy study.
+
+    Attributes
+    ----------
+    root : str
+        Output directory of the workflow (``results/discrepancy``).
+    tests : list[str]
+        Virtual tests with measured observables.
+    suffixes : list[str]
+        Shear-cell case-id suffixes of one run (``_s<k>`` or ``_s<k>_p<j>``), the measured
+        load conditions among those of the design.
+    outputs : list[str]
+        Measured observables (their surrogates are needed).
+    candidates : list[Candidate]
+        Applicable candidates (the current model lacks them).
+    """
+
+    root: str
+    tests: list[str]
+    suffixes: list[str]
+    outputs: list[str]
+    candidates: list[Candidate]
+
+    @classmethod
+    def from_config(cls, config: Mapping[str, Any], results: str = "results") -> DiscrepancyPlan:
+        """The plan of a validated configuration (reads its experiment file)."""
+        experiment = load_experiment(config["experiment"])
+        candidates = [
+            c
+            for c in parse_candidates(config["discrepancy"]["candidates"])
+            if applicability(c, config)[0]
+        ]
+        return cls(
+            root=f"{results}/discrepancy",
+            tests=measured_tests(experiment),
+            suffixes=run_suffixes(config, experiment),
+            outputs=measured_observables(experiment),
+            candidates=candidates,
+        )
+
+    def case_ids(self, bases: Sequence[str]) -> list[tuple[str, str]]:
+        """(test, case id) of runs ``bases`` in every measured test."""
+        ids = []
+        for test in self.tests:
+            for base in bases:
+                if test == "shear_cell":
+                    ids += [(test, f"{base}{suffix}") for suffix in self.suffixes]
+                else:
+                    ids.append((test, base))
+        return ids
+
+    def bulk_files(self, stage: str, bases: Sequence[str]) -> list[str]:
+        """``bulk.csv`` of runs ``bases`` under ``<root>/<stage>``."""
+        return [f"{self.root}/{stage}/{t}/{c}/bulk.csv" for t, c in self.case_ids(bases)]
+
+    @property
+    def probe_cases(self) -> list[str]:
+        return [run.case for run in probe_runs(self.candidates)]
+
+    def probe_bulk(self, find_record: str | Path) -> list[str]:
+        """Bulk files of all probe runs, or none when Find found nothing missing."""
+        return self.bulk_files("probes", self.probe_cases) if missing(find_record) else []
+
+    def reference_bulk(self, find_record: str | Path) -> list[str]:
+        """Bulk files of the reference probe run, or none when nothing is missing."""
+        return self.bulk_files("probes", [REFERENCE_CASE]) if missing(find_record) else []
+
+    def extended_bulk(self, design: str | Path) -> list[str]:
+        """Bulk files of the extended design's runs (none when no effect was named)."""
+        table = pd.read_csv(design, dtype={"case_id": str})
+        return self.bulk_files("extended", list(table["case_id"])) if len(table) else []
+
+    def verification_bulk(self, ranking_record: str | Path) -> list[str]:
+        """Bulk files of the verification runs, or none when no effect was named."""
+        return (
+            self.bulk_files("verification", [VERIFICATION_CASE]) if winner(ranking_record) else []
+        )
+
+    def show_inputs(
+        self, find_record: str | Path, ranking_record: str | Path
+    ) -> dict[str, str | list[str]]:
+        """Inputs of the Show step that depend on the checkpoints."""
+        out: dict[str, str | list[str]] = {"reference": self.reference_bulk(find_record)}
+        if winner(ranking_record):
+            out["recalibration"] = f"{self.root}/recalibration.json"
+            out["after_table"] = f"{self.root}/find_after.csv"
+            out["verification"] = self.verification_bulk(ranking_record)
+        return out
+
+    def model_files(self, stage: str) -> list[str]:
+        """Surrogate files of the measured observables (``surrogates`` or the extended ones)."""
+        if stage == "current":
+            return [f"{Path(self.root).parent}/surrogates/{o}/model.pt" for o in self.outputs]
+        return [f"{self.root}/surrogates/{o}/model.pt" for o in self.outputs]
+
+
+def missing(find_record: str | Path) -> bool:
+    """Whether Find found the gap above its threshold."""
+    return bool(json.loads(Path(find_record).read_text())["missing"])
+
+
+def winner(ranking_record: str | Path) -> str | None:
+    """Name of the effect the ranking named, or None."""
+    return json.loads(Path(ranking_record).read_text()).get("winner")

@@ -1,0 +1,273 @@
+"""Tables, texts and the figure of the discrepancy workflow (Find, Name, Show)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+from demcal.discrepancy.find import FindResult, format_stress
+
+__all__ = [
+    "KEY_COLUMNS",
+    "find_markdown",
+    "gap_figure",
+    "gap_of",
+    "gap_table",
+    "markdown_table",
+    "ranking_markdown",
+    "verification_markdown",
+]
+
+#: Columns that identify an observation.
+KEY_COLUMNS = ("observable", "normal_stress", "P")
+
+
+def markdown_table(frame: pd.DataFrame, floatfmt: str = ".4g") -> str:
+    """A GitHub-flavoured markdown table (NaN shown as empty)."""
+
+    def cell(value: Any) -> str:
+        if isinstance(value, float | np.floating):
+            return "" if not math.isfinite(value) else format(float(value), floatfmt)
+        return str(value).replace("|", "/")
+
+    header = "| " + " | ".join(str(c) for c in frame.columns) + " |"
+    rule = "|" + "|".join("---" for _ in frame.columns) + "|"
+    body = ["| " + " | ".join(cell(v) for v in row) + " |" for row in frame.itertuples(False)]
+    return "\n".join([header, rule, *body]) + "\n"
+
+
+def _condition(row: Any) -> str:
+    if not math.isfinite(row.normal_stress):
+        return "-"
+    return f"{format_stress(row.normal_stress)}, P = {row.P:g}"
+
+
+def find_markdown(result: FindResult, material: str, box_bounds: Mapping[str, Any]) -> str:
+    """The Find report: verdict, gap, theta*, sentences and the per-observation table."""
+    obs = result.observations
+    lines = [
+        f"# Discrepancy - Find: {material}",
+        "",
+        f"**Verdict: {result.verdict}.**",
+        "",
+        f"Gap figure G = sqrt(min chi^2 / N) = sqrt({result.best.deviance:.3g} / {len(obs)}) "
+        f"= {result.gap:.3f} (threshold {result.threshold:g}); z = (model - measured) / sigma "
+        "with sigma = sqrt(measurement sd^2 + surrogate held-out RMSE^2).",
+        "",
+        "Where the disagreement sits:",
+        "",
+        *[f"- {s}" for s in result.sentences],
+        "",
+        "Best joint point theta* of the current model (parameter box in brackets):",
+        "",
+    ]
+    for name, value in result.best.theta.items():
+        lo, hi = box_bounds[name]
+        lines.append(f"- {name} = {value:.4g} [{lo:g}, {hi:g}]")
+    table = pd.DataFrame(
+        {
+            "observable": obs["observable"],
+            "condition": [_condition(r) for r in obs.itertuples()],
+            "measured": obs["measured"],
+            "sigma": obs["sigma"],
+            "model range": [
+                f"{a:.4g} .. {b:.4g}"
+                for a, b in zip(obs["reach_min"], obs["reach_max"], strict=True)
+            ],
+            "best |z| alone": obs["best_abs_z"],
+            "at theta*": obs["at_best"],
+            "z at theta*": obs["z_at_best"],
+        }
+    )
+    lines += ["", markdown_table(table, ".3g")]
+    return "\n".join(lines)
+
+
+def ranking_markdown(
+    table: pd.DataFrame,
+    winner: str | None,
+    n_observations: int,
+    min_delta_bic: float,
+    min_explained: float = 0.0,
+    notes: Sequence[str] = (),
+    verdict: str | None = None,
+) -> str:
+    """The Name report: the ranking with scores, fitted magnitudes and signatures."""
+    lines = ["# Discrepancy - Name: which effect explains the gap", ""]
+    if verdict is not None:
+        lines += [f"Not run: {verdict}.", ""]
+        return "\n".join(lines)
+    penalty = math.log(n_observations) if n_observations > 0 else math.nan
+    lines += [
+        "Score: dBIC = D_0 - D_c - ln N against 'nothing missing' (one extra parameter; "
+        f"N = {n_observations}, ln N = {penalty:.2f}), D = sum ((model - measured) / s)^2 with "
+        "s^2 = sigma^2 + 2 RMSE^2 (a probe response is the difference of two DEM runs); "
+        "explained = share of D_0 removed; gap = sqrt(D_c / N). A candidate is named when "
+        f"dBIC >= {min_delta_bic:g} and explained >= {min_explained:g}.",
+        "",
+        f"**Named: {winner}.**" if winner else "**No candidate beats 'nothing missing' clearly.**",
+        "",
+    ]
+    shown = table.copy()
+    columns = [
+        c
+        for c in (
+            "rank",
+            "candidate",
+            "parameter",
+            "magnitude",
+            "delta_bic",
+            "explained",
+            "gap",
+            "status",
+            "signature",
+        )
+        if c in shown
+    ]
+    lines.append(markdown_table(shown[columns], ".3g"))
+    descriptions = table[["candidate", "description"]].drop_duplicates()
+    lines += ["", "Candidates:", ""]
+    lines += [f"- {r.candidate}: {r.description}" for r in descriptions.itertuples()]
+    if notes:
+        lines += ["", "Notes:", "", *[f"- {n}" for n in notes]]
+    return "\n".join(lines) + "\n"
+
+
+def gap_of(z: pd.Series | np.ndarray) -> float:
+    """sqrt(mean z^2) over the finite entries (NaN when there are none)."""
+    arr = np.asarray(z, dtype=float)
+    arr = arr[np.isfinite(arr)]
+    return float(np.sqrt(np.mean(arr**2))) if arr.size else math.nan
+
+
+def gap_table(
+    before: pd.DataFrame,
+    after: pd.DataFrame | None,
+    dem_before: np.ndarray | None,
+    dem_after: np.ndarray | None,
+) -> pd.DataFrame:
+    """Per observation: misfit before and after the effect was added, surrogates and DEM.
+
+    Parameters
+    ----------
+    before : DataFrame, shape (K, ...)
+        Find observations of the current model (measured, sigma, at_best, z_at_best).
+    after : DataFrame or None
+        Find observations of the extended model on the same observations.
+    dem_before, dem_after : ndarray, shape (K,), or None
+        DEM values at theta* (current model) and at the extended model's best point. Their z
+        uses the current model's sigma for both, so the two are directly comparable.
+
+    Returns
+    -------
+    DataFrame, shape (K, 15)
+        Also ``sigma_common`` (the larger sigma of the two models) and the misfits of both
+        models on it (``z_before_common``, ``z_after_common``).
+    """
+    out = before[[*KEY_COLUMNS, "measured", "sigma"]].copy().reset_index(drop=True)
+    out["model_before"] = before["at_best"].to_numpy(float)
+    out["z_before"] = before["z_at_best"].to_numpy(float)
+    if after is not None:
+        merged = out[list(KEY_COLUMNS)].merge(
+            after[[*KEY_COLUMNS, "sigma", "at_best", "z_at_best"]], on=list(KEY_COLUMNS), how="left"
+        )
+        out["sigma_after"] = merged["sigma"].to_numpy(float)
+        out["model_after"] = merged["at_best"].to_numpy(float)
+        out["z_after"] = merged["z_at_best"].to_numpy(float)
+    else:
+        out["sigma_after"] = out["model_after"] = out["z_after"] = math.nan
+    # One yardstick for both models: the larger of their sigmas, so that a less certain
+    # extended surrogate cannot shrink the gap by its uncertainty alone.
+    common = np.fmax(out["sigma"].to_numpy(float), out["sigma_after"].to_numpy(float))
+    out["sigma_common"] = common
+    out["z_before_common"] = (out["model_before"] - out["measured"]) / common
+    out["z_after_common"] = (out["model_after"] - out["measured"]) / common
+    for label, values in (("before", dem_before), ("after", dem_after)):
+        vals = np.full(len(out), math.nan) if values is None else np.asarray(values, float)
+        out[f"dem_{label}"] = vals
+        out[f"z_dem_{label}"] = (vals - out["measured"]) / out["sigma"]
+    return out
+
+
+def _labels(table: pd.DataFrame) -> list[str]:
+    labels = []
+    for row in table.itertuples():
+        if math.isfinite(row.normal_stress):
+            labels.append(f"{row.observable}\n{row.normal_stress:.0f} Pa, P={row.P:g}")
+        else:
+            labels.append(str(row.observable))
+    return labels
+
+
+def gap_figure(table: pd.DataFrame, title: str, path: str | Path) -> None:
+    """|z| per observation before and after, surrogate and DEM panels, with the gap figures."""
+    x = np.arange(len(table))
+    fig, axes = plt.subplots(
+        2, 1, figsize=(max(6.0, 0.55 * len(table) + 2.0), 6.5), sharex=True, constrained_layout=True
+    )
+    panels = (
+        ("surrogate best fit (common sigma)", "z_before_common", "z_after_common"),
+        ("DEM verification", "z_dem_before", "z_dem_after"),
+    )
+    for ax, (name, zb, za) in zip(axes, panels, strict=True):
+        before = np.abs(table[zb].to_numpy(float))
+        after = np.abs(table[za].to_numpy(float))
+        ax.bar(x - 0.2, before, 0.4, label=f"before (gap {gap_of(table[zb]):.2f})", color="C3")
+        if np.isfinite(after).any():
+            ax.bar(x + 0.2, after, 0.4, label=f"after (gap {gap_of(table[za]):.2f})", color="C0")
+        ax.axhline(1.0, color="0.5", lw=0.8, ls="--")
+        ax.set_ylabel("|z| = |model - measured| / sigma")
+        ax.set_title(name, fontsize=10)
+        ax.legend(fontsize=8, loc="upper right")
+    axes[-1].set_xticks(x, _labels(table), rotation=60, ha="right", fontsize=7)
+    fig.suptitle(title, fontsize=11)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def verification_markdown(table: pd.DataFrame, summary: Mapping[str, Any]) -> str:
+    """DEM at the extended model's identified point against the measurements and theta*."""
+    lines = ["# Discrepancy - Show: verification DEM runs", ""]
+    if not summary.get("extended"):
+        lines += [f"No extended model: {summary.get('reason', '')}.", ""]
+        if np.isfinite(table["dem_before"].to_numpy(float)).any():
+            lines += ["DEM at theta* of the current model:", ""]
+            shown = table[[*KEY_COLUMNS, "measured", "sigma", "dem_before", "z_dem_before"]]
+            lines.append(markdown_table(shown, ".4g"))
+        return "\n".join(lines) + "\n"
+    params = ", ".join(f"{k} = {v:.4g}" for k, v in summary["identified"].items())
+    lines += [
+        f"Effect added: {summary['winner']} ({summary['parameter']}); identified point of the "
+        f"extended model: {params}.",
+        "",
+        f"Surrogate gap on a common sigma (the larger of both models'): "
+        f"{summary['gap_before_common']:.3f} before, {summary['gap_after']:.3f} after "
+        f"({summary['gap_ratio']:.1f} x smaller).",
+        "",
+        f"DEM gap before (current model at theta*): {summary['dem_gap_before']:.3f}; after "
+        f"(extended model at its identified point): {summary['dem_gap_after']:.3f}; z uses the "
+        "current model's sigma in both.",
+        "",
+    ]
+    shown = table[
+        [
+            *KEY_COLUMNS,
+            "measured",
+            "sigma",
+            "dem_before",
+            "z_dem_before",
+            "dem_after",
+            "z_dem_after",
+        ]
+    ]
+    lines.append(markdown_table(shown, ".4g"))
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,118 @@
+"""The runs of the discrepancy workflow: which deck to render for a probe, extended-design or
+verification case (light to import, so that the rendering rules run in-process)."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from demcal.core.rule_log import rule_log
+from demcal.decks.render import render_case
+from demcal.discrepancy.candidates import (
+    REFERENCE_CASE,
+    Candidate,
+    base_point,
+    case_setup,
+    parse_candidates,
+)
+
+__all__ = ["candidate_by_name", "discrepancy_case", "render_discrepancy_run"]
+
+
+def candidate_by_name(config: Mapping[str, Any], name: str) -> Candidate:
+    """The catalogue entry called ``name``.
+
+    Raises
+    ------
+    KeyError
+        When the catalogue has no such candidate.
+    """
+    for cand in parse_candidates(config["discrepancy"]["candidates"]):
+        if cand.name == name:
+            return cand
+    raise KeyError(f"discrepancy.candidates: no candidate named {name!r}")
+
+
+def discrepancy_case(
+    mode: str,
+    test: str,
+    case: str,
+    config: Mapping[str, Any],
+    record: Mapping[str, Any],
+    design: pd.DataFrame | None = None,
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Case row and configuration of one run of the discrepancy workflow.
+
+    Parameters
+    ----------
+    mode : {"probe", "extended", "verification"}
+        probe: the reference or a candidate level at theta* (``record`` = Find record);
+        extended: a row of the extended design (``record`` = ranking record, ``design``);
+        verification: the extended model's best point (``record`` = recalibration record).
+    test, case : str
+        Test and case id (``<run>_s<k>[_p<j>]`` for the shear cell).
+    config : mapping
+        The validated configuration of the current model.
+
+    Raises
+    ------
+    KeyError
+        For a case id that belongs to no run of the mode.
+    """
+    run = case.split("_s")[0] if test == "shear_cell" else case
+    if mode == "probe":
+        point = dict(record["point"])
+        if run == REFERENCE_CASE:
+            return case_setup(test, case, point, config, None, None)
+        for cand in parse_candidates(config["discrepancy"]["candidates"]):
+            for j, level in enumerate(cand.probe_levels):
+                if cand.case_id(j) == run:
+                    return case_setup(test, case, point, config, cand, level)
+        raise KeyError(f"probe case {case!r}: no candidate level of that name")
+    if mode == "extended":
+        if design is None:
+            raise ValueError("extended case: the extended design table is needed")
+        cand = candidate_by_name(config, str(record["winner"]))
+        rows = design[design["case_id"] == run]
+        if rows.empty:
+            raise KeyError(f"extended case {case!r} is not in the extended design")
+        values = {k: float(v) for k, v in rows.iloc[0].items() if k != "case_id"}
+        point = base_point(values, config)
+        return case_setup(test, case, point, config, cand, values[cand.parameter])
+    if mode == "verification":
+        cand = candidate_by_name(config, str(record["winner"]))
+        point = dict(record["point"])
+        return case_setup(test, case, point, config, cand, float(record["magnitude"]))
+    raise ValueError(f"unknown mode {mode!r}; expected probe, extended or verification")
+
+
+def render_discrepancy_run(
+    mode: str,
+    test: str,
+    case: str,
+    config: Mapping[str, Any],
+    record_path: str | Path,
+    deck: str | Path,
+    log: str,
+    design_path: str | Path | None = None,
+) -> dict[str, Any]:
+    """Render one probe, extended-design or verification run (deck file ``deck``), logging to
+    ``log``.
+
+    ``record_path`` is the Find record (probe), the ranking record (extended, with
+    ``design_path``) or the recalibration record (verification); see :func:`discrepancy_case`.
+
+    Returns
+    -------
+    dict
+        The ``case.json`` content written by :func:`demcal.decks.render.render_case`.
+    """
+    with rule_log(log):
+        record = json.loads(Path(record_path).read_text())
+        design = pd.read_csv(design_path, dtype={"case_id": str}) if design_path else None
+        row, cfg = discrepancy_case(mode, test, case, config, record, design)
+        return render_case(test, row, cfg, Path(deck).parent)

@@ -1,0 +1,292 @@
+"""Synthetic measurements with a hidden effect, for testing the discrepancy workflow.
+
+A *truth* file (``config/experiments/truth/hidden_*.yaml``) gives the true parameters, the
+effect switched on in the engine (``switch``, configuration overrides) and the name of that
+effect. The engine runs the virtual tests with it; noise is added; the resulting experiment
+file holds only the noisy bulk values. The model under calibration lacks the effect; the truth
+file is never read by the workflow, only by the study set-up and the tests that check the
+named effect.
+
+The hidden-effect study model is the profile's configuration with the overrides of
+:func:`study_overrides`: one particle size, no rolling resistance, no cohesion, and a design
+over sliding friction (and particle density at the quick scale). With that model a missing
+cohesion, rolling resistance or size spread can each be hidden in the data.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import yaml
+
+from demcal.bulk.synthetic import run_case_bulk
+from demcal.core.config import validate_config
+from demcal.design.cases import load_condition, shear_suffixes
+from demcal.discrepancy.candidates import deep_merge
+
+__all__ = [
+    "hidden_effect_bulk",
+    "prepare_study",
+    "replicate_record",
+    "study_config",
+    "study_overrides",
+    "write_hidden_effect_experiment",
+]
+
+_MODEL = {
+    "particles": {"distribution": "monodisperse"},
+    "material": {"rolling_friction": False},
+    "design": {"kind": "lhs"},
+}
+
+_PROFILES: dict[str, dict[str, Any]] = {
+    # Two stresses show how an effect changes with stress; one shear load (P = 0.5) gives one
+    # run per stress with all three shear-cell observables. The particle density is taken as
+    # measured (pycnometer), so that a few cases give trustworthy surrogates; up to 0.9: the
+    # soft tiny cell turns unstable near coefficientFriction 1.
+    "tiny": {
+        "particles": {"radius": 0.0015},
+        "design": {
+            "n": 8,
+            "seed": 3,
+            "ranges": {"coefficientFriction": [0.1, 0.9]},
+            "fixed": {
+                "coefficientRollingFriction": 0.0,
+                "coefficientRestitution": 0.7,
+                "density": 2800.0,
+            },
+        },
+        "shear_cell": {"normal_stresses": [1068.0, 2029.0], "P": [0.5]},
+        # The angle of repose is not measured in the study; its design runs are kept short.
+        "angle_of_repose": {"dCylDp": 6, "lift_time": 0.5, "final_settle_fall_times": 1.0},
+        "surrogate": {"hidden_sizes": [3, 6], "max_epochs": 300, "patience": 20},
+    },
+    "quick": {
+        "particles": {"radius": 0.002},
+        "design": {
+            "n": 16,
+            "seed": 1,
+            "ranges": {"coefficientFriction": [0.1, 0.9], "density": [2500.0, 3500.0]},
+            "fixed": {"coefficientRollingFriction": 0.0, "coefficientRestitution": 0.7},
+        },
+        "shear_cell": {"normal_stresses": [1068.0, 2029.0, 10070.0], "P": [0.5]},
+    },
+}
+
+
+def study_overrides(profile: str) -> dict[str, Any]:
+    """Configuration overrides that turn a profile into the hidden-effect study model.
+
+    Raises
+    ------
+    KeyError
+        For a profile without a study variant.
+    """
+    if profile not in _PROFILES:
+        raise KeyError(f"no hidden-effect study for profile {profile!r} (have {list(_PROFILES)})")
+    return deep_merge(_MODEL, _PROFILES[profile])
+
+
+def study_config(raw: Mapping[str, Any], profile: str | None = None) -> dict[str, Any]:
+    """A profile's raw configuration turned into the hidden-effect study model.
+
+    The design's ranges and fixed values are replaced (not merged), so the study varies exactly
+    the parameters of :func:`study_overrides` whatever the profile varies.
+    """
+    overrides = study_overrides(profile or str(raw.get("profile", "quick")))
+    out = deep_merge(raw, overrides)
+    out["design"]["ranges"] = dict(overrides["design"]["ranges"])
+    out["design"]["fixed"] = dict(overrides["design"]["fixed"])
+    return out
+
+
+def prepare_study(
+    profile_config: str | Path,
+    truth_path: str | Path,
+    study_dir: str | Path,
+    noise: float = 0.005,
+    seed: int = 1,
+    engine_command: str | None = None,
+    workers: int = 2,
+    replicates: int = 3,
+) -> Path:
+    """Set up a hidden-effect study directory ready for ``snakemake discrepancy``.
+
+    Writes ``config/config.yaml`` (the study model, with its experiment file) and
+    ``config/experiments/measured.yaml`` (the mean of ``replicates`` truth runs with their
+    scatter and ``noise`` as sd) under ``study_dir``; the truth stays where it is.
+
+    Returns
+    -------
+    Path
+        The study configuration file.
+    """
+    study_dir = Path(study_dir)
+    (study_dir / "config" / "experiments").mkdir(parents=True, exist_ok=True)
+    raw = yaml.safe_load(Path(profile_config).read_text()) or {}
+    config = study_config(raw)
+    config["experiment"] = "config/experiments/measured.yaml"
+    if engine_command is not None:
+        config.setdefault("engine", {})["command"] = engine_command
+    path = study_dir / "config" / "config.yaml"
+    path.write_text(yaml.safe_dump(config, sort_keys=False))
+    validated = validate_config(copy.deepcopy(config), str(path))
+    write_hidden_effect_experiment(
+        truth_path,
+        validated,
+        study_dir / config["experiment"],
+        study_dir / "truth_runs",
+        noise,
+        seed,
+        workers=workers,
+        replicates=replicates,
+    )
+    return path
+
+
+def hidden_effect_bulk(
+    truth: Mapping[str, Any],
+    config: Mapping[str, Any],
+    work_dir: str | Path,
+    tests: Sequence[str] = ("shear_cell",),
+    workers: int = 2,
+    replicates: int = 1,
+) -> pd.DataFrame:
+    """Bulk values of the virtual tests at the true parameters with the hidden effect on.
+
+    Parameters
+    ----------
+    truth : mapping
+        ``parameters`` (case columns), ``switch`` (configuration overrides) and optionally
+        ``profiles`` (per profile, parameter values that replace those of ``parameters``, for
+        an effect of similar strength at another scale).
+    config : mapping
+        The study configuration (the model under calibration).
+    work_dir : path
+        Where the runs are made.
+    tests : sequence of str
+        Virtual tests to run; the shear-cell runs are those of a design row
+        (:func:`demcal.design.cases.shear_suffixes`).
+    workers : int
+        Runs at the same time.
+    replicates : int
+        Repetitions of every run with a different configuration seed (a fresh packing), as a
+        laboratory repeats a test; column ``replicate`` numbers them.
+
+    Raises
+    ------
+    RuntimeError
+        When a run fails (names the case directory and the engine's error).
+    """
+    cfg = deep_merge(config, truth.get("switch") or {})
+    per_profile = (truth.get("profiles") or {}).get(str(cfg.get("profile")), {})
+    params = {k: float(v) for k, v in {**truth["parameters"], **per_profile}.items()}
+    cases: list[tuple[str, dict[str, Any], int]] = []
+    for r in range(replicates):
+        if "angle_of_repose" in tests:
+            cases.append(("angle_of_repose", {"case_id": f"truth{r}", **params}, r))
+        if "shear_cell" in tests:
+            for suffix in shear_suffixes(cfg):
+                key = f"truth{r}{suffix}"
+                row = {"case_id": key, **params, **load_condition(cfg, key)}
+                cases.append(("shear_cell", row, r))
+
+    def run(item: tuple[str, dict[str, Any], int]) -> pd.DataFrame:
+        test, case, r = item
+        run_cfg = deep_merge(cfg, {"seed": int(cfg["seed"]) + r})
+        case_dir = Path(work_dir) / test / case["case_id"]
+        rows = run_case_bulk(test, case, run_cfg, case_dir, "truth run")
+        rows["replicate"] = r
+        return rows
+
+    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+        frames = list(pool.map(run, cases))
+    return pd.concat(frames, ignore_index=True)
+
+
+def replicate_record(
+    bulk: pd.DataFrame, material: str, noise: float, seed: int, source: str
+) -> dict[str, Any]:
+    """An experiment-file mapping: the mean of the replicates with its standard deviation.
+
+    Every value is the mean over the n replicate runs times (1 + noise * N(0, 1)); its sd is
+    sqrt(s^2 / n + (noise * mean)^2) with s the sample standard deviation of the replicates (0
+    for a single run): the standard error of the mean combined with the added noise, the
+    uncertainty of the value that is stated.
+
+    Parameters
+    ----------
+    bulk : DataFrame
+        Output of :func:`hidden_effect_bulk`.
+    noise : float
+        Relative standard deviation of the added measurement noise.
+    """
+    rng = np.random.default_rng(seed)
+
+    def measured(values: pd.Series) -> tuple[float, float]:
+        vals = values.dropna().to_numpy(float)
+        mean = float(vals.mean())
+        scatter = float(vals.std(ddof=1) / math.sqrt(vals.size)) if vals.size > 1 else 0.0
+        value = mean * (1.0 + noise * rng.standard_normal()) if noise > 0 else mean
+        return value, math.hypot(scatter, noise * mean)
+
+    record: dict[str, Any] = {"material": material, "source": source}
+    aor = bulk[bulk["test"] == "angle_of_repose"]
+    if len(aor) and aor["aor"].notna().any():
+        value, sd = measured(aor["aor"])
+        record["angle_of_repose"] = {"value": round(value, 4), "sd": round(sd, 4)}
+    shear = bulk[bulk["test"] == "shear_cell"]
+    conditions = []
+    for (stress, p), rows in shear.groupby(["normal_stress", "P"], sort=True):
+        entry: dict[str, float] = {"normal_stress": float(stress), "P": float(p)}
+        for name in ("mu_psh", "mu_sh", "rho_b"):
+            if rows[name].notna().any():
+                value, sd = measured(rows[name])
+                entry[name] = round(value, 6)
+                entry[f"{name}_sd"] = round(sd, 6)
+        conditions.append(entry)
+    if conditions:
+        record["shear_cell"] = conditions
+    return record
+
+
+def write_hidden_effect_experiment(
+    truth_path: str | Path,
+    config: Mapping[str, Any],
+    out: str | Path,
+    work_dir: str | Path,
+    noise: float,
+    seed: int,
+    tests: Sequence[str] = ("shear_cell",),
+    workers: int = 2,
+    replicates: int = 3,
+) -> dict[str, Any]:
+    """Run the truth (``replicates`` times), add noise and write the experiment file ``out``.
+
+    Returns
+    -------
+    dict
+        The experiment record written (material, source, measured values with sd).
+    """
+    truth = yaml.safe_load(Path(truth_path).read_text())
+    bulk = hidden_effect_bulk(truth, config, work_dir, tests, workers, replicates)
+    record = replicate_record(
+        bulk,
+        str(truth["material"]),
+        noise,
+        seed,
+        f"dem_engine with a hidden effect ({config['profile']} profile), mean of {replicates} "
+        f"runs, noise {noise:.1%}",
+    )
+    Path(out).write_text(
+        "# Synthetic measurements with a hidden effect; the truth is kept apart and never read\n"
+        "# by the workflow.\n" + yaml.safe_dump(record, sort_keys=False)
+    )
+    return record

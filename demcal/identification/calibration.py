@@ -1,0 +1,165 @@
+"""Identification: screening the candidate grid against the measurements (paper eqs. 3-4).
+
+Three screenings as in the paper's Table 5: the shear-cell conditions alone (SSC), the angle of
+repose alone (AoR), and both (shear-cell conditions, then AoR on the marked sets).
+"""
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import torch
+
+from demcal.core.experiments import Experiment
+from demcal.identification.acceptance import within_tolerance
+from demcal.identification.screening import Stage, draw_axes, screen, stage_from_condition
+from demcal.identification.statistics import (
+    combine_statistics,
+    identified_parameters,
+    valid_set_statistics,
+)
+
+GROUPS = ("SSC", "AoR", "SSC & AoR")
+
+
+class ConstantInputs:
+    """A predictor with some inputs held at constants, exposing only the remaining ones.
+
+    Parameters
+    ----------
+    model : object
+        Has ``predict_torch(X: Tensor (n, d)) -> Tensor (n,)`` over ``features``.
+    features : sequence of str
+        The model's ordered input names.
+    constants : mapping
+        Values of inputs that are not screened (e.g. dCylDp of the test).
+    """
+
+    def __init__(self, model: Any, features: Sequence[str], constants: Mapping[str, float]):
+        self.model = model
+        self.features = list(features)
+        self.constants = {k: float(v) for k, v in constants.items() if k in features}
+        self.free = [f for f in self.features if f not in self.constants]
+
+    def predict_torch(self, X: torch.Tensor) -> torch.Tensor:
+        full = torch.empty((X.shape[0], len(self.features)), dtype=X.dtype)
+        for k, name in enumerate(self.features):
+            if name in self.constants:
+                full[:, k] = self.constants[name]
+            else:
+                full[:, k] = X[:, self.free.index(name)]
+        return self.model.predict_torch(full)
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        return self.predict_torch(torch.as_tensor(X, dtype=torch.float32)).double().numpy()
+
+
+@dataclass
+class CalibrationResult:
+    axes: dict[str, np.ndarray]
+    valid: dict[str, pd.DataFrame]  # per group, the valid parameter sets
+    n_total: int
+    elapsed_s: float
+    table5: pd.DataFrame
+    identified: dict[str, dict[str, float]]
+    identified_group: str
+
+
+def _aor_stage(value: float, tol: float) -> Stage:
+    return Stage(
+        name="aor",
+        outputs=("aor",),
+        accept=partial(within_tolerance, measured={"aor": value}, tol=tol),
+        fixed={},
+    )
+
+
+def calibrate(
+    surrogates: Mapping[str, tuple[Any, Sequence[str]]],
+    experiment: Experiment,
+    screening: Mapping[str, Any],
+    constants: Mapping[str, Mapping[str, float]],
+) -> CalibrationResult:
+    """Screen the candidate grid and return the valid sets per group with Table 5.
+
+    Parameters
+    ----------
+    surrogates : mapping
+        Output name -> (model, feature names).
+    experiment : Experiment
+        The measurements; only what was measured is matched.
+    screening : mapping
+        The ``screening`` config section (axes, seed, chunk_size, threads, tolerance).
+    constants : mapping
+        Output name -> inputs held constant for that network (e.g. the test's dCylDp).
+
+    Raises
+    ------
+    ValueError
+        When a network input is neither a screening axis, a load variable nor a constant.
+    """
+    spec = {k: (float(v[0]), float(v[1]), int(v[2])) for k, v in screening["axes"].items()}
+    axes = draw_axes(spec, int(screening["seed"]))
+    tol = float(screening["tolerance"])
+    predictors = {}
+    for output, (model, features) in surrogates.items():
+        wrapped = ConstantInputs(model, features, constants.get(output, {}))
+        missing = [f for f in wrapped.free if f not in axes and f not in ("normal_stress", "P")]
+        if missing:
+            raise ValueError(
+                f"network {output}: input(s) {missing} vary in the design but are neither "
+                "screening axes (screening.axes) nor held constant"
+            )
+        predictors[output] = (wrapped, wrapped.free)
+    shear_stages = [
+        stage_from_condition(c, tol)
+        for c in experiment.shear_conditions
+        if all(o in predictors for o in c.values)
+    ]
+    aor_stages = (
+        [_aor_stage(experiment.angle_of_repose, tol)]
+        if experiment.angle_of_repose is not None and "aor" in predictors
+        else []
+    )
+    plans = {"SSC": shear_stages, "AoR": aor_stages, "SSC & AoR": shear_stages + aor_stages}
+    valid: dict[str, pd.DataFrame] = {}
+    n_total, elapsed = 0, 0.0
+    for group, stages in plans.items():
+        if not stages or (group == "SSC & AoR" and not (shear_stages and aor_stages)):
+            continue
+        result = screen(
+            predictors,
+            axes,
+            fixed={},
+            stages=stages,
+            tol=tol,
+            chunk_size=int(screening["chunk_size"]),
+            num_threads=int(screening["threads"]),
+        )
+        valid[group] = result.to_frame(axes)
+        n_total = result.n_total
+        elapsed += result.elapsed_s
+    ranges = {k: (v[0], v[1]) for k, v in spec.items()}
+    tables = [
+        valid_set_statistics(valid[g], ranges, n_total, label=g) for g in GROUPS if g in valid
+    ]
+    table5 = combine_statistics(tables) if tables else pd.DataFrame()
+    chosen = next((g for g in reversed(GROUPS) if g in valid and len(valid[g]) > 0), None)
+    identified = identified_parameters(valid[chosen], list(axes)) if chosen else {}
+    return CalibrationResult(axes, valid, n_total, elapsed, table5, identified, chosen or "")
+
+
+def write_valid_sets(result: CalibrationResult, out_dir: str | Path) -> dict[str, Path]:
+    """Valid sets per group as compressed CSV (``valid_<group>.csv.gz``)."""
+    out_dir = Path(out_dir)
+    paths = {}
+    for group, frame in result.valid.items():
+        name = group.lower().replace(" & ", "_").replace(" ", "_")
+        path = out_dir / f"valid_{name}.csv.gz"
+        frame.to_csv(path, index=False, float_format="%.6g")
+        paths[group] = path
+    return paths

@@ -1,0 +1,3 @@
+"""The virtual bulk tests: the Schulze shear cell and the lifted-cylinder angle of repose,
+each with its set-up (derived quantities) and its readout (bulk values from engine output).
+"""

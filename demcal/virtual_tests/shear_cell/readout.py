@@ -1,0 +1,317 @@
+"""Bulk values of the virtual Schulze shear test: mu_psh, mu_sh and rho_b per pre-shear cycle.
+
+Input is the table of the deck's ``fix print`` file (read by
+:func:`demcal.engine_io.output.read_print_file`), one row per print step, with the columns
+
+=============  ==========================================================================
+time           s
+phase          0 settle, 1 pre-shear, 2 unload, 3 shear
+cycle          0, 1, 2, ... one per pre-shear/shear cycle
+lid_z          m, lid height
+lid_force      N, normal force of the particles on the lid (positive)
+shear_force    N, horizontal force on the moving bottom part along the shear direction
+travel         m, displacement of the moving part since the start of the cycle
+mass           kg, particle mass in the cell
+target_force   N, the servo's target lid force in that phase
+=============  ==========================================================================
+
+The split-cylinder cell of radius ``R`` has its floor at ``z_floor`` and its shear plane at
+``z_shear``. With ``A(s)`` the overlap area of the two cylinder sections shifted by the travel
+``s``:
+
+* ``rho_b = mass / (pi R^2 (lid_z - z_floor))``,
+* ``sigma = (lid_force + rho_b g pi R^2 (lid_z - z_shear)) / A``: lid force plus the weight of
+  the bulk between the shear plane and the lid,
+* ``tau = |shear_force| / A`` and ``mu = tau / sigma``.
+
+``mu_psh`` and ``mu_sh`` are the means of ``mu`` over the steady plateaus detected (by
+:func:`demcal.virtual_tests.steady_state.detect_plateau`) in the pre-shear and the shear phase of a
+cycle;
+``rho_b`` is averaged over the pre-shear plateau. ``P`` is the ratio of the servo target forces
+of shear and pre-shear, and ``normal_stress`` the pre-shear target force over ``pi R^2``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from demcal.engine_io.output import require_columns
+from demcal.virtual_tests.steady_state import Plateau, detect_plateau
+
+__all__ = [
+    "PHASE_PRE_SHEAR",
+    "PHASE_SETTLE",
+    "PHASE_SHEAR",
+    "PHASE_UNLOAD",
+    "REQUIRED_COLUMNS",
+    "overlap_area",
+    "shear_cell_bulk_values",
+    "shear_stress_series",
+]
+
+PHASE_SETTLE = 0
+PHASE_PRE_SHEAR = 1
+PHASE_UNLOAD = 2
+PHASE_SHEAR = 3
+
+REQUIRED_COLUMNS: tuple[str, ...] = (
+    "time",
+    "phase",
+    "cycle",
+    "lid_z",
+    "lid_force",
+    "shear_force",
+    "travel",
+    "mass",
+    "target_force",
+)
+
+_SOURCE = "shear-cell table"
+
+
+def overlap_area(radius: float, travel: float | np.ndarray) -> float | np.ndarray:
+    """Area shared by two circles of equal radius whose centres are ``travel`` apart.
+
+    ``A = 2 R^2 acos(d / 2R) - (d / 2) sqrt(4 R^2 - d^2)`` with ``d = |travel|``, and zero for
+    ``d >= 2R``.
+
+    Parameters
+    ----------
+    radius : float
+        Circle (cell) radius R (m), positive.
+    travel : float or numpy.ndarray
+        Centre distance, any shape (m); the sign is ignored.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Overlap area (m^2), same shape as ``travel``.
+
+    Raises
+    ------
+    ValueError
+        ``radius`` is not positive or ``travel`` is not finite.
+    """
+    if not radius > 0.0:
+        raise ValueError(f"radius must be positive, got {radius}")
+    d = np.abs(np.asarray(travel, dtype=np.float64))
+    if not np.all(np.isfinite(d)):
+        raise ValueError("travel must be finite")
+    ratio = np.minimum(d / (2.0 * radius), 1.0)
+    half_chord = np.sqrt(np.maximum(radius**2 - (d / 2.0) ** 2, 0.0))
+    area = 2.0 * radius**2 * np.arccos(ratio) - d * half_chord
+    area = np.where(d >= 2.0 * radius, 0.0, area)
+    return float(area) if area.ndim == 0 else area
+
+
+def _validated(table: pd.DataFrame, radius: float, z_floor: float, z_shear: float) -> None:
+    require_columns(list(table.columns), REQUIRED_COLUMNS, _SOURCE)
+    if not radius > 0.0:
+        raise ValueError(f"radius must be positive, got {radius}")
+    if not z_shear > z_floor:
+        raise ValueError(f"z_shear ({z_shear}) must lie above z_floor ({z_floor})")
+    for name in REQUIRED_COLUMNS:
+        values = pd.to_numeric(table[name], errors="coerce").to_numpy(dtype=np.float64)
+        bad = ~np.isfinite(values)
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"{_SOURCE}: column {name!r} has a missing or non-numeric value in row {row}"
+            )
+    sheared = table["phase"].isin([PHASE_PRE_SHEAR, PHASE_SHEAR]).to_numpy()
+    lid_z = table["lid_z"].to_numpy(dtype=np.float64)
+    low = sheared & (lid_z <= z_shear)
+    if low.any():
+        row = int(np.flatnonzero(low)[0])
+        raise ValueError(
+            f"{_SOURCE}: column 'lid_z' = {lid_z[row]} is not above the shear plane "
+            f"z_shear = {z_shear} in row {row}"
+        )
+    travel = np.abs(table["travel"].to_numpy(dtype=np.float64))
+    far = sheared & (travel >= 2.0 * radius)
+    if far.any():
+        row = int(np.flatnonzero(far)[0])
+        raise ValueError(
+            f"{_SOURCE}: column 'travel' = {travel[row]} leaves no overlap of the cell halves "
+            f"(2R = {2.0 * radius}) in row {row}"
+        )
+
+
+def shear_stress_series(
+    table: pd.DataFrame,
+    radius: float,
+    z_floor: float,
+    z_shear: float,
+    g: float = 9.81,
+) -> pd.DataFrame:
+    """Add the time series of area, bulk density, stresses and mu to a shear-cell table.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Shape (n_rows, ...), the print-file table with the columns in :data:`REQUIRED_COLUMNS`.
+    radius : float
+        Cell radius R (m).
+    z_floor : float
+        Height of the cell floor (m).
+    z_shear : float
+        Height of the shear plane (m).
+    g : float
+        Gravitational acceleration (m/s^2).
+
+    Returns
+    -------
+    pandas.DataFrame
+        A copy of ``table`` with the added columns ``area`` (m^2), ``rho_b`` (kg/m^3),
+        ``sigma`` (Pa), ``tau`` (Pa) and ``mu`` (-).
+
+    Raises
+    ------
+    demcal.engine_io.output.MissingColumnError
+        A required column is absent.
+    ValueError
+        Non-finite values, a lid at or below the shear plane, or a travel of 2R or more
+        during pre-shear or shear.
+    """
+    _validated(table, radius, z_floor, z_shear)
+    out = table.copy()
+    cross_section = np.pi * radius**2
+    lid_z = out["lid_z"].to_numpy(dtype=np.float64)
+    area = np.asarray(overlap_area(radius, out["travel"].to_numpy(dtype=np.float64)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # Settling and unloading rows may have a lid near the floor; only phases 1 and 3 count.
+        rho_b = out["mass"].to_numpy(dtype=np.float64) / (cross_section * (lid_z - z_floor))
+        weight_above = rho_b * g * cross_section * (lid_z - z_shear)
+        sigma = (out["lid_force"].to_numpy(dtype=np.float64) + weight_above) / area
+        tau = np.abs(out["shear_force"].to_numpy(dtype=np.float64)) / area
+        mu = tau / sigma
+    out["area"] = area
+    out["rho_b"] = rho_b
+    out["sigma"] = sigma
+    out["tau"] = tau
+    out["mu"] = mu
+    return out
+
+
+def _phase_plateau(rows: pd.DataFrame, plateau_kwargs: dict[str, Any]) -> Plateau | None:
+    """Plateau of mu over the rows of one phase, or None if the phase is absent."""
+    if rows.empty:
+        return None
+    # A step printed twice at a run boundary carries no new information.
+    rows = rows.drop_duplicates(subset="time", keep="last")
+    t = rows["time"].to_numpy(dtype=np.float64)
+    if np.any(np.diff(t) <= 0.0):
+        row = int(rows.index[int(np.flatnonzero(np.diff(t) <= 0.0)[0]) + 1])
+        raise ValueError(f"{_SOURCE}: column 'time' decreases within a phase at row {row}")
+    return detect_plateau(t, rows["mu"].to_numpy(dtype=np.float64), **plateau_kwargs)
+
+
+def shear_cell_bulk_values(
+    table: pd.DataFrame,
+    radius: float,
+    z_floor: float,
+    z_shear: float,
+    g: float = 9.81,
+    **plateau_kwargs: Any,
+) -> pd.DataFrame:
+    """Bulk values of every pre-shear/shear cycle of a shear-cell run.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        Shape (n_rows, ...), the print-file table with the columns in :data:`REQUIRED_COLUMNS`.
+    radius : float
+        Cell radius R (m).
+    z_floor : float
+        Height of the cell floor (m).
+    z_shear : float
+        Height of the shear plane (m).
+    g : float
+        Gravitational acceleration (m/s^2).
+    **plateau_kwargs
+        Passed on to :func:`demcal.virtual_tests.steady_state.detect_plateau` (e.g.
+        ``min_fraction``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cycle that has a pre-shear or shear phase, with columns ``cycle``, ``P``
+        (-), ``normal_stress`` (Pa), ``mu_psh``, ``mu_sh`` (-), ``rho_b`` (kg/m^3),
+        ``steady_psh``, ``steady_sh`` (bool), the plateau windows ``psh_t_start``,
+        ``psh_t_end``, ``sh_t_start``, ``sh_t_end`` (s), the standard errors ``mu_psh_sem``,
+        ``mu_sh_sem`` (-) and the detector's ``psh_reason``, ``sh_reason``. Values of a
+        missing phase are NaN and its steady flag is False.
+
+    Raises
+    ------
+    demcal.engine_io.output.MissingColumnError
+        A required column is absent.
+    ValueError
+        Invalid geometry or table values (see :func:`shear_stress_series`), a non-positive
+        pre-shear target force, or time running backwards within a phase.
+    """
+    series = shear_stress_series(table, radius, z_floor, z_shear, g)
+    cross_section = np.pi * radius**2
+    records = []
+    phase = series["phase"].to_numpy()
+    cycles = np.unique(series["cycle"].to_numpy()[np.isin(phase, [PHASE_PRE_SHEAR, PHASE_SHEAR])])
+    for cycle in cycles:
+        in_cycle = series["cycle"] == cycle
+        pre = series[in_cycle & (series["phase"] == PHASE_PRE_SHEAR)]
+        shear = series[in_cycle & (series["phase"] == PHASE_SHEAR)]
+        p_psh = _phase_plateau(pre, plateau_kwargs)
+        p_sh = _phase_plateau(shear, plateau_kwargs)
+
+        target_pre = float(pre["target_force"].median()) if not pre.empty else np.nan
+        target_sh = float(shear["target_force"].median()) if not shear.empty else np.nan
+        if not pre.empty and not target_pre > 0.0:
+            raise ValueError(
+                f"{_SOURCE}: column 'target_force' must be positive during pre-shear "
+                f"(cycle {int(cycle)}, median {target_pre})"
+            )
+        rho_b = np.nan
+        if p_psh is not None:
+            rows = pre.drop_duplicates(subset="time", keep="last")
+            rho_b = float(rows["rho_b"].iloc[p_psh.start_index : p_psh.end_index].mean())
+        records.append(
+            {
+                "cycle": int(cycle),
+                "P": target_sh / target_pre,
+                "normal_stress": target_pre / cross_section,
+                "mu_psh": p_psh.mean if p_psh else np.nan,
+                "mu_sh": p_sh.mean if p_sh else np.nan,
+                "rho_b": rho_b,
+                "steady_psh": bool(p_psh.steady) if p_psh else False,
+                "steady_sh": bool(p_sh.steady) if p_sh else False,
+                "psh_t_start": p_psh.start_time if p_psh else np.nan,
+                "psh_t_end": p_psh.end_time if p_psh else np.nan,
+                "sh_t_start": p_sh.start_time if p_sh else np.nan,
+                "sh_t_end": p_sh.end_time if p_sh else np.nan,
+                "mu_psh_sem": p_psh.sem if p_psh else np.nan,
+                "mu_sh_sem": p_sh.sem if p_sh else np.nan,
+                "psh_reason": p_psh.reason if p_psh else "no pre-shear phase",
+                "sh_reason": p_sh.reason if p_sh else "no shear phase",
+            }
+        )
+    columns = [
+        "cycle",
+        "P",
+        "normal_stress",
+        "mu_psh",
+        "mu_sh",
+        "rho_b",
+        "steady_psh",
+        "steady_sh",
+        "psh_t_start",
+        "psh_t_end",
+        "sh_t_start",
+        "sh_t_end",
+        "mu_psh_sem",
+        "mu_sh_sem",
+        "psh_reason",
+        "sh_reason",
+    ]
+    return pd.DataFrame.from_records(records, columns=columns)
