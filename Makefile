@@ -10,7 +10,7 @@ ENGINE_SOURCES := $(shell find dem_engine/src dem_engine/CMakeLists.txt -type f 
 CORES ?= all
 SNAKEMAKE_ARGS ?=
 
-.PHONY: setup sysdeps engine run test lint bench clean
+.PHONY: setup sysdeps engine run test lint bench docs clean
 
 setup: $(PY_STAMP) sysdeps engine
 
@@ -24,7 +24,7 @@ $(PY_STAMP): requirements.txt pyproject.toml
 		|| { tail -30 $(VENV)/pip.log; exit 1; }
 	@touch $@
 
-# Debian packages that off-screen pyvista rendering needs.
+# Debian packages: off-screen pyvista rendering, LIGGGHTS 3.8 and OpenMPI.
 sysdeps:
 	@bash scripts/install_system_packages.sh
 
@@ -49,6 +49,10 @@ lint: setup
 
 bench: setup
 	source $(VENV)/bin/activate && python dem_engine/bench/run_bench.py
+
+# The configuration reference, generated from the schema (tests/unit/test_docs.py checks it).
+docs: $(PY_STAMP)
+	$(PY) -m demcal.core.config_reference --output docs/configuration.md
 
 clean:
 	rm -rf $(ENGINE_BUILD) .snakemake results

@@ -14,7 +14,8 @@ include: "workflow/rules/common.smk"
 wildcard_constraints:
     test="shear_cell|angle_of_repose",
     case=r"[A-Za-z0-9]+(_s\d+(_p\d+)?)?",
-    stage="cases|verification|discrepancy/probes|discrepancy/extended|discrepancy/verification",
+    stage="cases|verification/[a-z][a-z0-9_]*|discrepancy/probes|discrepancy/extended|discrepancy/verification",
+    engine="[a-z][a-z0-9_]*",
     output="mu_psh|mu_sh|rho_b|aor",
 
 
@@ -32,6 +33,7 @@ rule all:
     input:
         design=DESIGN_TABLE,
         dataset=DATASET,
+        run_times=f"{RESULTS}/bulk/run_times.csv",
         table4=f"{RESULTS}/surrogates/table4.md",
         table5=f"{RESULTS}/identification/table5.md",
         verification=f"{RESULTS}/verification/verification.md",

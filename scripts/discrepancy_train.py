@@ -1,29 +1,24 @@
 """Discrepancy step 3 (Add): the surrogate of one bulk value of the extended model."""
 
-import json
-from pathlib import Path
-
 import pandas as pd
 
 from demcal.core.rule_log import rule_log
 from demcal.discrepancy.extension import train_extended_surrogate
-from demcal.discrepancy.runs import candidate_by_name
+from demcal.discrepancy.runs import named_candidate
 
 
-def main(sm) -> None:
-    with rule_log(sm.log[0]) as logger:
-        config = dict(sm.config)
-        record = json.loads(Path(sm.input.ranking).read_text())
-        candidate = candidate_by_name(config, record["winner"])
+def main(snakemake) -> None:
+    with rule_log(snakemake.log[0]) as logger:
+        config = dict(snakemake.config)
+        candidate = named_candidate(config, snakemake.input.ranking)
         meta = train_extended_surrogate(
-            pd.read_csv(sm.input.dataset),
-            sm.wildcards.output,
+            pd.read_csv(snakemake.input.dataset),
+            snakemake.wildcards.output,
             dict(config["surrogate"]),
             [candidate.parameter],
-            sm.output.model,
+            snakemake.output.model,
         )
-        logger.info("%s: %s", sm.wildcards.output, meta)
+        logger.info("%s: %s", snakemake.wildcards.output, meta)
 
 
-if __name__ == "__main__":
-    main(snakemake)  # noqa: F821
+main(snakemake)  # noqa: F821

@@ -6,13 +6,8 @@ Usage: python scripts/make_synthetic_experiment.py --config config/tiny.yaml \\
 """
 
 import argparse
-import tempfile
-from pathlib import Path
 
-import yaml
-
-from demcal.bulk.synthetic import experiment_record, simulate_reference
-from demcal.core.config import load_config
+from demcal.bulk.synthetic import write_synthetic_experiment
 
 
 def main() -> None:
@@ -27,24 +22,14 @@ def main() -> None:
     )
     parser.add_argument("--P", default=None, help="shear load fractions to keep, comma-separated")
     args = parser.parse_args()
-    config = load_config(args.config)
-    truth = yaml.safe_load(Path(args.truth).read_text())
-    with tempfile.TemporaryDirectory() as tmp:
-        bulk = simulate_reference(truth["parameters"], config, tmp)
-    record = experiment_record(
-        bulk,
-        f"{truth['material']} ({config['profile']} profile)",
+    write_synthetic_experiment(
+        args.config,
+        args.truth,
+        args.out,
         args.noise,
         args.seed,
-        f"dem_engine at the parameters of {Path(args.truth).name}, {args.config}, "
-        f"noise {args.noise:.1%}",
-        observables=tuple(args.observables.split(",")),
-        p_values=tuple(float(p) for p in args.P.split(",")) if args.P else None,
-    )
-    Path(args.out).write_text(
-        "# Synthetic measurements made by scripts/make_synthetic_experiment.py; the true\n"
-        "# parameters are kept apart and never read by the workflow.\n"
-        + yaml.safe_dump(record, sort_keys=False)
+        observables=args.observables.split(","),
+        p_values=[float(p) for p in args.P.split(",")] if args.P else None,
     )
     print(f"wrote {args.out}")
 

@@ -1,16 +1,14 @@
 """Render the chute-cooler deck, meshes and case.json (Snakemake script)."""
 
-from pathlib import Path
-
-from demcal.application.chute_cooler.deck import read_identified_parameters, render_chute_cooler
+from demcal.application.chute_cooler.steps import render_from_config
 from demcal.core.rule_log import rule_log
 
 
-def main(config: dict, params_file: str | None, deck: str, log: str) -> None:
-    with rule_log(log) as logger:
-        identified = read_identified_parameters(params_file) if params_file else None
-        record = render_chute_cooler(
-            config, Path(deck).parent, identified, params_file or "identified parameters"
+def main(snakemake) -> None:
+    deck = snakemake.output.deck
+    with rule_log(snakemake.log[0]) as logger:
+        record = render_from_config(
+            dict(snakemake.config), getattr(snakemake.input, "params", None), deck
         )
         s = record["setup"]
         logger.info(
@@ -23,7 +21,4 @@ def main(config: dict, params_file: str | None, deck: str, log: str) -> None:
         )
 
 
-if __name__ == "__main__":
-    sm = snakemake  # noqa: F821
-    params_file = getattr(sm.input, "params", None)
-    main(dict(sm.config), params_file, sm.output.deck, sm.log[0])
+main(snakemake)  # noqa: F821

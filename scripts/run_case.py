@@ -6,9 +6,10 @@ from demcal.core.rule_log import rule_log
 from demcal.engine_io.run import run_deck
 
 
-def main(deck: str, command: str, threads: int, log: str) -> None:
-    with rule_log(log) as logger:
-        status = run_deck(Path(deck).parent, Path(deck).name, command, threads)
+def main(snakemake) -> None:
+    deck = Path(snakemake.input.deck)
+    with rule_log(snakemake.log[0]) as logger:
+        status = run_deck(deck.parent, deck.name, snakemake.params.command, snakemake.threads)
         if status["status"] == "ok":
             logger.info("%s finished in %.1f s", deck, status["seconds"])
         else:
@@ -16,6 +17,4 @@ def main(deck: str, command: str, threads: int, log: str) -> None:
             logger.warning("%s FAILED: %s", deck, status["error"])
 
 
-if __name__ == "__main__":
-    sm = snakemake  # noqa: F821
-    main(sm.input.deck, sm.params.command, sm.threads, sm.log[0])
+main(snakemake)  # noqa: F821

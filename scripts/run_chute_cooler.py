@@ -6,14 +6,13 @@ from demcal.core.rule_log import rule_log
 from demcal.engine_io.run import run_deck
 
 
-def main(deck: str, command: str, threads: int, log: str) -> None:
-    with rule_log(log) as logger:
-        status = run_deck(Path(deck).parent, Path(deck).name, command, threads)
+def main(snakemake) -> None:
+    deck, threads = Path(snakemake.input.deck), snakemake.threads
+    with rule_log(snakemake.log[0]) as logger:
+        status = run_deck(deck.parent, deck.name, snakemake.params.command, threads)
         if status["status"] != "ok":
             raise RuntimeError(f"{deck}: engine run failed: {status['error']}")
         logger.info("%s finished in %.1f s on %d thread(s)", deck, status["seconds"], threads)
 
 
-if __name__ == "__main__":
-    sm = snakemake  # noqa: F821
-    main(sm.input.deck, sm.params.command, sm.threads, sm.log[0])
+main(snakemake)  # noqa: F821

@@ -1,23 +1,22 @@
-"""Compare the verification DEM runs at the identified set with the measurements."""
+"""Compare the verification DEM runs at the identified set (one list of runs per engine) with
+the measurements and with each other."""
 
-import pandas as pd
-
-from demcal.core.experiments import load_experiment
 from demcal.core.rule_log import rule_log
-from demcal.identification.verification import verification_table
+from demcal.identification.verification_run import write_verification_table
 
 
-def main(sm) -> None:
-    with rule_log(sm.log[0]):
-        runs = pd.concat([pd.read_csv(p) for p in sm.input.bulk], ignore_index=True)
-        table = verification_table(
-            runs, load_experiment(sm.input.experiment), float(sm.params.tolerance)
+def main(snakemake) -> None:
+    engines = snakemake.params.engines
+    with rule_log(snakemake.log[0]):
+        write_verification_table(
+            {engine: getattr(snakemake.input, f"bulk_{engine}") for engine in engines},
+            snakemake.input.experiment,
+            snakemake.params.tolerance,
+            snakemake.output.csv,
+            snakemake.output.table,
+            commands=engines,
+            threads=snakemake.params.threads,
         )
-        table.to_csv(sm.output.csv, index=False)
-        with open(sm.output.table, "w") as fh:
-            fh.write("# Verification: DEM at the identified mean set vs measurement\n\n")
-            fh.write(table.to_string(index=False) + "\n")
 
 
-if __name__ == "__main__":
-    main(snakemake)  # noqa: F821
+main(snakemake)  # noqa: F821

@@ -117,11 +117,16 @@ std::vector<Triangle> cylinder_mesh(double radius, double z0, double z1, int seg
   return tris;
 }
 
+// The contacts a sphere touching the mesh for the first time makes (no earlier contacts).
 std::vector<MeshContact> contacts_of(const Vec3& x, double r, const TriMesh& mesh) {
   std::vector<dem::TriRef> refs;
   for (std::uint32_t t = 0; t < mesh.size(); ++t) refs.push_back({0, t});
   std::vector<MeshContact> out;
   find_mesh_contacts(x, r, refs.data(), static_cast<int>(refs.size()), {&mesh}, out);
+  std::vector<double> slots(dem::kMeshSlots * dem::kMeshSlotWidth, 0.0);
+  std::vector<double*> hist;
+  std::vector<double> overflow(64 * dem::kHistorySize);
+  dem::assign_history_slots(slots.data(), out, {&mesh}, hist, overflow.data());
   return out;
 }
 
@@ -314,17 +319,18 @@ TEST_CASE("mesh: closest point equals a brute-force search on random triangles")
   CHECK(vertices > 1000);
 }
 
-// --- contact deduplication ---------------------------------------------------------------------
+// --- contacts: active edges and corners, coplanar patches (LIGGGHTS rules) ---------------------
 
-TEST_CASE("mesh: a sphere on the shared edge of two coplanar triangles has one contact") {
+TEST_CASE("mesh: a sphere on two coplanar triangles has one contact") {
   const TriMesh plate(square_plate(1.0, 0.0), "plate");
   const double r = 0.1;
-  // Centre right above the diagonal: both triangles report the same edge point.
+  // Centre right above the diagonal: both faces, the second a coplanar neighbour of the first.
   auto c = contacts_of(Vec3{0.3, 0.3, 0.09}, r, plate);
   CHECK_EQ(c.size(), std::size_t{1});
+  CHECK_EQ(c[0].tri, 0u);
   CHECK(same_vec(c[0].normal, Vec3{0, 0, 1}, 1e-12));
   CHECK_NEAR(c[0].dist, 0.09, 1e-14);
-  // Slightly off the diagonal: the face of one triangle, the other's edge is redundant.
+  // Slightly off the diagonal: the face of one triangle; the diagonal is an inactive edge.
   c = contacts_of(Vec3{0.31, 0.3, 0.09}, r, plate);
   CHECK_EQ(c.size(), std::size_t{1});
   CHECK(c[0].cp.on_face());
@@ -332,13 +338,19 @@ TEST_CASE("mesh: a sphere on the shared edge of two coplanar triangles has one c
   c = contacts_of(Vec3{0.3, 0.31, 0.09}, r, plate);
   CHECK_EQ(c.size(), std::size_t{1});
   CHECK_EQ(c[0].tri, 1u);
-  // Above the shared corner (-1,-1): still one contact with the vertex.
+  // Beyond the shared corner (-1,-1): one contact, on the boundary edge of triangle 0.
   c = contacts_of(Vec3{-1.05, -1.05, 0.02}, r, plate);
   CHECK_EQ(c.size(), std::size_t{1});
+  CHECK(same_vec(c[0].cp.point, Vec3{-1, -1, 0}, 1e-14));
+  // Beyond the middle of a boundary edge: the edge.
+  c = contacts_of(Vec3{1.05, 0.2, 0.02}, r, plate);
+  CHECK_EQ(c.size(), std::size_t{1});
+  CHECK(same_vec(c[0].cp.point, Vec3{1, 0.2, 0}, 1e-14));
 }
 
-TEST_CASE("mesh: convex ridge gives one contact, concave corner one per face") {
-  // Roof: two faces meeting at the ridge x = 0, z = 0, sloping down at 45 degrees.
+TEST_CASE("mesh: a convex edge belongs to the later triangle, a concave corner gets both faces") {
+  // Roof: two faces meeting at the ridge x = 0, z = 0, sloping down at 45 degrees; the ridge is
+  // shared by triangles 0 and 2 and active in triangle 2 only.
   const std::vector<Triangle> roof = {
       Triangle{{Vec3{0, -1, 0}, Vec3{-1, -1, -1}, Vec3{0, 1, 0}}},
       Triangle{{Vec3{-1, -1, -1}, Vec3{-1, 1, -1}, Vec3{0, 1, 0}}},
@@ -346,11 +358,20 @@ TEST_CASE("mesh: convex ridge gives one contact, concave corner one per face") {
       Triangle{{Vec3{1, -1, -1}, Vec3{0, 1, 0}, Vec3{1, 1, -1}}},
   };
   const TriMesh ridge(roof, "roof");
+  CHECK(!ridge.topology().edge_active(0, 2));
+  CHECK(ridge.topology().edge_active(2, 0));
   auto c = contacts_of(Vec3{0.0, 0.2, 0.08}, 0.1, ridge);
   CHECK_EQ(c.size(), std::size_t{1});
+  CHECK_EQ(c[0].tri, 2u);
   CHECK(same_vec(c[0].normal, Vec3{0, 0, 1}, 1e-12));
-  // Near the ridge on one slope: the face contact only.
+  // Near the ridge on the left slope: its face, and the ridge of triangle 2 as well, which the
+  // sphere overlaps (LIGGGHTS counts both).
   c = contacts_of(Vec3{-0.05, 0.2, 0.0}, 0.1, ridge);
+  CHECK_EQ(c.size(), std::size_t{2});
+  CHECK(c[0].cp.on_face());
+  CHECK_EQ(c[1].tri, 2u);
+  // Near the ridge on the right slope: only its face (the left triangle's ridge is inactive).
+  c = contacts_of(Vec3{0.05, 0.2, 0.0}, 0.1, ridge);
   CHECK_EQ(c.size(), std::size_t{1});
   CHECK(c[0].cp.on_face());
 
@@ -362,6 +383,31 @@ TEST_CASE("mesh: convex ridge gives one contact, concave corner one per face") {
   c = contacts_of(Vec3{0.0, 0.2, 0.13}, 0.1, groove);
   CHECK_EQ(c.size(), std::size_t{2});
   for (const auto& k : c) CHECK(k.cp.on_face());
+  // With a curvature above the 90 degree bend... not allowed: it exceeds the triangle angles.
+  TriMesh bent = groove;
+  CHECK_THROWS_AS(bent.set_curvature(59.0, "valley"), EngineError);
+}
+
+TEST_CASE("mesh: faces bent less than the curvature are one surface") {
+  // Two panels bent by 10 degrees at x = 0, each of two triangles.
+  const double s = std::sin(10 * kPi / 180), cz = std::cos(10 * kPi / 180);
+  const std::vector<Triangle> bent = {
+      Triangle{{Vec3{-1, -1, 0}, Vec3{0, -1, 0}, Vec3{0, 1, 0}}},
+      Triangle{{Vec3{-1, -1, 0}, Vec3{0, 1, 0}, Vec3{-1, 1, 0}}},
+      Triangle{{Vec3{0, -1, 0}, Vec3{cz, -1, s}, Vec3{cz, 1, s}}},
+      Triangle{{Vec3{0, -1, 0}, Vec3{cz, 1, s}, Vec3{0, 1, 0}}},
+  };
+  TriMesh mesh(bent, "bent");
+  // A sphere in the concave bend touches both panels ...
+  const Vec3 x{0.0, 0.3, 0.098};
+  CHECK_EQ(contacts_of(x, 0.1, mesh).size(), std::size_t{2});
+  CHECK(!mesh.topology().coplanar_neighbours(0, 3));
+  // ... but once with a curvature of 20 degrees (the later panel is skipped).
+  mesh.set_curvature(20.0, "bent");
+  CHECK(mesh.topology().coplanar_neighbours(0, 3));
+  const auto c = contacts_of(x, 0.1, mesh);
+  CHECK_EQ(c.size(), std::size_t{1});
+  CHECK_EQ(c[0].tri, 0u);
 }
 
 TEST_CASE("mesh: a vertex shared by a fan of triangles gives one contact") {
@@ -379,41 +425,51 @@ TEST_CASE("mesh: a vertex shared by a fan of triangles gives one contact") {
   CHECK(same_vec(c[0].cp.point, Vec3{0, 0, 0}, 1e-14));
 }
 
+TEST_CASE("mesh: triangles sharing only a vertex both touch a sphere at it") {
+  // A bow tie: two triangles meeting at the origin, not coplanar.
+  const std::vector<Triangle> tie = {
+      Triangle{{Vec3{0, 0, 0}, Vec3{-4, -1, 0}, Vec3{-4, 1, 0}}},
+      Triangle{{Vec3{0, 0, 0}, Vec3{4, 1, -1}, Vec3{4, -1, -1}}},
+  };
+  const TriMesh mesh(tie, "tie");
+  CHECK_EQ(contacts_of(Vec3{0.05, 0.01, 0.9}, 1.0, mesh).size(), std::size_t{2});
+}
+
 // --- contact history slots ---------------------------------------------------------------------
 
 TEST_CASE("mesh: history persists, moves across a flat edge and is released when it opens") {
   const TriMesh plate(square_plate(1.0, 0.0), "plate");
-  const std::vector<double> cos_curv = {std::cos(0.256235 * kPi / 180)};
+  const std::vector<const TriMesh*> meshes = {&plate};
   std::vector<double> slots(dem::kMeshSlots * dem::kMeshSlotWidth, 0.0);
   std::vector<double*> hist;
   std::vector<double> overflow(64 * dem::kHistorySize);
   auto c = contacts_of(Vec3{0.5, 0.2, 0.09}, 0.1, plate);  // face of triangle 0
   CHECK_EQ(c.size(), std::size_t{1});
-  CHECK_EQ(dem::assign_history_slots(slots.data(), c, cos_curv, hist, overflow.data()), 0);
+  CHECK_EQ(dem::assign_history_slots(slots.data(), c, meshes, hist, overflow.data()), 0);
   CHECK_EQ(hist[0][0], 0.0);
   hist[0][0] = 1.5e-6;  // a tangential spring
   hist[0][5] = -2.0;
   // Next step, same triangle: same history.
-  dem::assign_history_slots(slots.data(), c, cos_curv, hist, overflow.data());
+  dem::assign_history_slots(slots.data(), c, meshes, hist, overflow.data());
   CHECK_EQ(hist[0][0], 1.5e-6);
   // Rolled across the diagonal onto triangle 1: the history follows.
   c = contacts_of(Vec3{0.2, 0.5, 0.09}, 0.1, plate);
   CHECK_EQ(c.size(), std::size_t{1});
   CHECK_EQ(c[0].tri, 1u);
-  dem::assign_history_slots(slots.data(), c, cos_curv, hist, overflow.data());
+  dem::assign_history_slots(slots.data(), c, meshes, hist, overflow.data());
   CHECK_EQ(hist[0][0], 1.5e-6);
   CHECK_EQ(hist[0][5], -2.0);
   // Lifted off: all slots are released; touching again starts from zero.
   c.clear();
-  dem::assign_history_slots(slots.data(), c, cos_curv, hist, overflow.data());
+  dem::assign_history_slots(slots.data(), c, meshes, hist, overflow.data());
   CHECK(std::all_of(slots.begin(), slots.end(), [](double v) { return v == 0.0; }));
   c = contacts_of(Vec3{0.2, 0.5, 0.09}, 0.1, plate);
-  dem::assign_history_slots(slots.data(), c, cos_curv, hist, overflow.data());
+  dem::assign_history_slots(slots.data(), c, meshes, hist, overflow.data());
   CHECK_EQ(hist[0][0], 0.0);
 }
 
 TEST_CASE("mesh: history does not move between faces bent more than the curvature") {
-  // Two faces at 10 degrees; curvature 5 degrees keeps them apart, 20 degrees joins them.
+  // Two panels at 10 degrees; curvature 5 degrees keeps them apart, 20 degrees joins them.
   const double s = std::sin(10 * kPi / 180), cz = std::cos(10 * kPi / 180);
   const std::vector<Triangle> bent = {
       Triangle{{Vec3{-1, -1, 0}, Vec3{0, -1, 0}, Vec3{0, 1, 0}}},
@@ -421,20 +477,24 @@ TEST_CASE("mesh: history does not move between faces bent more than the curvatur
       Triangle{{Vec3{0, -1, 0}, Vec3{cz, -1, s}, Vec3{cz, 1, s}}},
       Triangle{{Vec3{0, -1, 0}, Vec3{cz, 1, s}, Vec3{0, 1, 0}}},
   };
-  const TriMesh mesh(bent, "bent");
   for (const double curvature : {5.0, 20.0}) {
-    const std::vector<double> cos_curv = {std::cos(curvature * kPi / 180)};
+    TriMesh mesh(bent, "bent");
+    mesh.set_curvature(curvature, "bent");
+    const std::vector<const TriMesh*> meshes = {&mesh};
     std::vector<double> slots(dem::kMeshSlots * dem::kMeshSlotWidth, 0.0);
     std::vector<double*> hist;
     std::vector<double> overflow(64 * dem::kHistorySize);
     auto c = contacts_of(Vec3{-0.3, 0.0, 0.09}, 0.1, mesh);
     CHECK_EQ(c.size(), std::size_t{1});
-    dem::assign_history_slots(slots.data(), c, cos_curv, hist, overflow.data());
+    CHECK_EQ(c[0].tri, 0u);
+    dem::assign_history_slots(slots.data(), c, meshes, hist, overflow.data());
     hist[0][1] = 7.0;
+    // On triangle 3, which shares the bend edge with triangle 0.
     const Vec3 n2{-s, 0, cz};
-    c = contacts_of(Vec3{0.5 * cz, 0.0, 0.5 * s} + 0.09 * n2, 0.1, mesh);
+    c = contacts_of(Vec3{0.5 * cz, 0.5, 0.5 * s} + 0.09 * n2, 0.1, mesh);
     CHECK_EQ(c.size(), std::size_t{1});
-    dem::assign_history_slots(slots.data(), c, cos_curv, hist, overflow.data());
+    CHECK_EQ(c[0].tri, 3u);
+    dem::assign_history_slots(slots.data(), c, meshes, hist, overflow.data());
     CHECK_EQ(hist[0][1], curvature > 10.0 ? 7.0 : 0.0);
   }
 }
@@ -519,7 +579,7 @@ TEST_CASE("mesh: rigid motions and frames carried by earlier motions") {
 }
 
 TEST_CASE("mesh: primitive planes and cylinders act from the side of the centre") {
-  std::vector<std::string> w = {"zplane", "0.5", "ycylinder", "2", "1", "3"};
+  std::vector<std::string> w = {"zplane", "0.5", "ycylinder", "2", "3", "1"};
   std::size_t pos = 0;
   const auto plane = dem::PrimitiveWall::parse(w, pos);
   CHECK_EQ(pos, std::size_t{2});
@@ -533,7 +593,8 @@ TEST_CASE("mesh: primitive planes and cylinders act from the side of the centre"
   CHECK(plane.contact(Vec3{9, 9, 0.45}, 0.2, n, d));
   CHECK(same_vec(n, Vec3{0, 0, -1}, 0));
   CHECK(!plane.contact(Vec3{0, 0, 0.8}, 0.2, n, d));
-  // ycylinder radius 2 about x = 1, z = 3: inside pushes towards the axis, outside away.
+  // ycylinder radius 2 about z = 3, x = 1 (LIGGGHTS order: z, then x): inside pushes towards
+  // the axis, outside away.
   CHECK(cyl.contact(Vec3{2.9, 7, 3}, 0.2, n, d));
   CHECK(same_vec(n, Vec3{-1, 0, 0}, 1e-15));
   CHECK_NEAR(d, 0.1, 1e-12);

@@ -45,7 +45,7 @@ TEST_CASE("partition: every thread of a team covers its share exactly once") {
   for (int c : seen) CHECK_EQ(c, 1);
 }
 
-TEST_CASE("neighbour list: pairs with history are marked touching after a rebuild") {
+TEST_CASE("neighbour list: a rebuild keeps the history of touching pairs only") {
   dem::Particles p;
   dem::Domain box;
   box.boundary = {'f', 'f', 'f'};
@@ -62,10 +62,14 @@ TEST_CASE("neighbour list: pairs with history are marked touching after a rebuil
   // A fresh list has no history, so nothing is touching yet.
   CHECK_EQ(list.touching[0] + list.touching[1], 0);
   list.history[0] = 1e-6;  // the 1-2 contact has a tangential spring
+  list.touching[0] = 1;
+  // The 2-3 pair touched before and opened: its history is stale (kept until the build).
+  list.history[dem::kHistorySize] = 2e-6;
   list.force_rebuild();
   list.build(p, box);
   CHECK_EQ(list.pairs(), std::size_t{2});
   CHECK_EQ(static_cast<int>(list.touching[0]), 1);
   CHECK_EQ(static_cast<int>(list.touching[1]), 0);
   CHECK_EQ(list.history[0], 1e-6);
+  CHECK_EQ(list.history[dem::kHistorySize], 0.0);
 }

@@ -9,19 +9,16 @@ from typing import Any
 import pandas as pd
 
 from demcal.bulk.values import extract
+from demcal.core.parameters import (
+    CONTACT_PARAMETERS,
+    GEOMETRY_PARAMETERS,
+    OPTIONAL_CONTACT_PARAMETERS,
+)
 from demcal.core.provenance import write_sidecar
 from demcal.core.rule_log import rule_log
 
 #: Contact and geometry parameters a case may carry (LIGGGHTS names).
-PARAMETERS = (
-    "coefficientFriction",
-    "coefficientRollingFriction",
-    "coefficientRestitution",
-    "density",
-    "cohesionEnergyDensity",
-    "wallFriction",
-    "dCylDp",
-)
+PARAMETERS = (*CONTACT_PARAMETERS, *OPTIONAL_CONTACT_PARAMETERS, *GEOMETRY_PARAMETERS)
 #: Bulk values per test.
 OUTPUTS = {"shear_cell": ("mu_psh", "mu_sh", "rho_b"), "angle_of_repose": ("aor",)}
 
@@ -114,3 +111,45 @@ def write_case_rows(
         rows = case_rows(test, Path(info).parent, extract, p_values)
         rows.to_csv(path, index=False, float_format="%.10g")
         write_sidecar(path, config, seed=int(config["seed"]), extra={"rows": len(rows)})
+
+
+def write_dataset(
+    bulk_files: Sequence[str | Path],
+    dataset: str | Path,
+    failed: str | Path,
+    config: Mapping[str, Any],
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Collect the bulk rows of every case into the tidy dataset and list the failed cases.
+
+    Parameters
+    ----------
+    bulk_files : sequence of path
+        ``bulk.csv`` of every case (:func:`write_case_rows`).
+    dataset : path
+        The tidy dataset (CSV), with a provenance sidecar ``<dataset>.json``.
+    failed : path
+        CSV of the failed cases: test, case_id, error.
+    config : mapping
+        The validated configuration (for the sidecar).
+
+    Returns
+    -------
+    data : pandas.DataFrame
+        The dataset, one row per case and load condition.
+    failed_cases : pandas.DataFrame
+        One row per failed case (kept in the dataset, excluded from training).
+    """
+    data = collect(pd.read_csv(path) for path in bulk_files)
+    data.to_csv(dataset, index=False, float_format="%.10g")
+    bad = data[data["status"] != "ok"].drop_duplicates("case_id")
+    bad[["test", "case_id", "error"]].to_csv(failed, index=False)
+    write_sidecar(
+        dataset,
+        config,
+        extra={
+            "rows": len(data),
+            "cases": int(data["case_id"].nunique()),
+            "failed_cases": len(bad),
+        },
+    )
+    return data, bad

@@ -4,17 +4,20 @@ The true parameters live in a file that the workflow never reads, so that tests 
 the identification recovers them.
 """
 
-from collections.abc import Mapping
+import tempfile
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
+import yaml
 
 from demcal.bulk.values import extract
-from demcal.decks.render import render_case
+from demcal.core.config import load_config
 from demcal.design.cases import load_condition, shear_suffixes
 from demcal.engine_io.run import run_deck
+from demcal.virtual_tests.deck import render_case
 
 
 def simulate_reference(
@@ -111,3 +114,53 @@ def experiment_record(
     if conditions:
         record["shear_cell"] = conditions
     return record
+
+
+def write_synthetic_experiment(
+    config_path: str | Path,
+    truth_path: str | Path,
+    out_path: str | Path,
+    noise: float = 0.0,
+    seed: int = 1,
+    observables: Sequence[str] = ("mu_psh", "mu_sh", "rho_b"),
+    p_values: Sequence[float] | None = None,
+) -> Path:
+    """Run the engine at the true parameters of a truth file and write an experiment file.
+
+    Parameters
+    ----------
+    config_path : path
+        Workflow configuration (profile) the virtual tests run with.
+    truth_path : path
+        File with ``material`` and the true ``parameters``; it is not copied into the output.
+    out_path : path
+        Experiment file to write.
+    noise, seed, observables, p_values
+        As in :func:`experiment_record`.
+
+    Returns
+    -------
+    Path
+        ``out_path``.
+    """
+    config = load_config(config_path)
+    truth = yaml.safe_load(Path(truth_path).read_text())
+    with tempfile.TemporaryDirectory() as tmp:
+        bulk = simulate_reference(truth["parameters"], config, tmp)
+    record = experiment_record(
+        bulk,
+        f"{truth['material']} ({config['profile']} profile)",
+        noise,
+        seed,
+        f"dem_engine at the parameters of {Path(truth_path).name}, {config_path}, "
+        f"noise {noise:.1%}",
+        observables=tuple(observables),
+        p_values=tuple(float(p) for p in p_values) if p_values else None,
+    )
+    out = Path(out_path)
+    out.write_text(
+        "# Synthetic measurements made by scripts/make_synthetic_experiment.py; the true\n"
+        "# parameters are kept apart and never read by the workflow.\n"
+        + yaml.safe_dump(record, sort_keys=False)
+    )
+    return out

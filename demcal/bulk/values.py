@@ -1,8 +1,7 @@
 """Bulk values of one rendered and run case of a virtual bulk test.
 
-:func:`extract` reads ``case.json`` (written by :func:`demcal.decks.render.render_case`) and the
-engine
-outputs in the case directory and returns the bulk values as a table:
+:func:`extract` reads ``case.json`` (written by :func:`demcal.virtual_tests.deck.render_case`)
+and the engine outputs in the case directory and returns the bulk values as a table:
 
 * shear cell: one row per load condition (cycle) with ``case_id``, ``test`` ("shear_cell"),
   ``normal_stress`` (Pa), ``P`` (-), ``mu_psh``, ``mu_sh`` (-), ``rho_b`` (kg/m^3),
@@ -27,7 +26,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from demcal.engine_io.output import read_dump_last, read_print_file
+from demcal.core.parameters import GRAVITY
+from demcal.decks.render import CASE_FILE
+from demcal.engine_io.dump_file import read_dump_last
+from demcal.engine_io.fix_output import read_print_file
 from demcal.virtual_tests.angle_of_repose.readout import angle_of_repose
 from demcal.virtual_tests.shear_cell.readout import REQUIRED_COLUMNS, shear_cell_bulk_values
 
@@ -40,7 +42,6 @@ __all__ = [
     "read_case_record",
 ]
 
-CASE_FILE = "case.json"
 
 #: Leading columns of the shear-cell table (diagnostics follow).
 SHEAR_COLUMNS = (
@@ -76,8 +77,6 @@ REPOSE_COLUMNS = (
 #: A heap counts as settled when its kinetic energy at the end is below this fraction of
 #: ``N m g d`` (N particles of the mean mass m lifted by one mean diameter d).
 SETTLED_ENERGY_RATIO = 1e-5
-
-_GRAVITY = 9.81
 
 
 class MissingOutputError(ValueError):
@@ -177,7 +176,7 @@ def _repose(case_dir: Path, record: Mapping[str, Any]) -> pd.DataFrame:
     diameter = 2.0 * float(particles["mass_mean_radius"])
     n_final = len(atoms)
     ke_final = float(table["ke"].iloc[-1])
-    scale = max(n_final, 1) * mean_mass * _GRAVITY * diameter
+    scale = max(n_final, 1) * mean_mass * GRAVITY * diameter
     sectors = result.sector_angles_deg
     finite = sectors[np.isfinite(sectors)]
     row: dict[str, Any] = {
@@ -209,7 +208,8 @@ def extract(test: str, case_dir: Path) -> pd.DataFrame:
     test : {"shear_cell", "angle_of_repose"}
         Which test the case directory holds.
     case_dir : Path
-        Directory written by :func:`demcal.decks.render.render_case` in which the engine has run.
+        Directory written by :func:`demcal.virtual_tests.deck.render_case` in which the engine
+        has run.
 
     Returns
     -------
@@ -224,7 +224,7 @@ def extract(test: str, case_dir: Path) -> pd.DataFrame:
         For an unknown test, or a case directory of another test.
     MissingOutputError
         For a missing or truncated output file or ``case.json`` (names the file).
-    demcal.engine_io.output.EngineOutputError
+    demcal.engine_io.output_errors.EngineOutputError
         For a malformed output file (names the file and line).
     """
     if test not in ("shear_cell", "angle_of_repose"):

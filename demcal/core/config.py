@@ -3,6 +3,11 @@
 The schema (``workflow/schemas/config.schema.yaml``, JSON Schema draft 2020-12) gives every key
 a description and a default; validation fills the defaults in and reports every problem with the
 dotted key path, so a typo or an out-of-range value stops the workflow before anything runs.
+
+Contact parameters are keys of free-form mappings in the schema (``design.ranges`` and others),
+so their names and values are checked afterwards against :mod:`demcal.core.parameters`: a
+misspelt name (``design.ranges.coefficientFrction``) or a value outside what LIGGGHTS accepts
+(a restitution of 1.5) is a configuration error that names the key.
 """
 
 from __future__ import annotations
@@ -14,6 +19,8 @@ from typing import Any
 
 import jsonschema
 import yaml
+
+from demcal.core.parameters import out_of_bounds, unknown_parameter
 
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas"
 
@@ -99,9 +106,106 @@ def validate(instance: dict, schema_name: str, source: str) -> dict:
     return instance
 
 
+def _values_problems(where: str, name: str, values: Any) -> list[str]:
+    """Problems of the values of parameter ``name`` given at key path ``where``."""
+    reason = unknown_parameter(name)
+    if reason is not None:
+        return [f"{where}: {reason}"]
+    if not isinstance(values, list):
+        problem = out_of_bounds(name, values)
+        return [f"{where}: {problem}"] if problem else []
+    problems = []
+    for i, value in enumerate(values):
+        problem = out_of_bounds(name, value)
+        if problem:
+            problems.append(f"{where}[{i}]: {problem}")
+    return problems
+
+
+def _candidate_problems(i: int, candidate: Mapping[str, Any]) -> list[str]:
+    """Problems of ``discrepancy.candidates[i]``: its parameter, range, probes and off value.
+
+    A candidate with a ``config_key`` names a new surrogate input, not a case column, and is
+    not checked.
+    """
+    if candidate.get("config_key") is not None:
+        return []
+    where = f"discrepancy.candidates[{i}]"
+    name = candidate["parameter"]
+    reason = unknown_parameter(name)
+    if reason is not None:
+        return [f"{where}.parameter: {name!r}: {reason}"]
+    problems = _values_problems(f"{where}.range", name, candidate["range"])
+    problems += _values_problems(f"{where}.probe_levels", name, candidate["probe_levels"])
+    off = candidate["off_value"]
+    if isinstance(off, str):
+        reason = unknown_parameter(off)
+        if reason is not None:
+            problems.append(f"{where}.off_value: {off!r}: {reason}")
+    else:
+        problems += _values_problems(f"{where}.off_value", name, off)
+    return problems
+
+
+def parameter_problems(config: Mapping[str, Any]) -> list[str]:
+    """Every misspelt contact-parameter name and out-of-bounds value of a configuration.
+
+    Checks the design (``ranges``, ``levels``, ``choices``, ``fixed``), the material's elastic
+    constants, the screening axes (low and high), the discrepancy candidates and the
+    application's parameters and wall friction.
+
+    Parameters
+    ----------
+    config : mapping
+        A configuration that passed the schema (with defaults filled in).
+
+    Returns
+    -------
+    list of str
+        One line per problem, starting with the dotted key path, e.g.
+        ``design.ranges.coefficientFrction: unknown contact parameter (did you mean
+        coefficientFriction?)``.
+    """
+    problems: list[str] = []
+    design = config.get("design", {})
+    for key in ("ranges", "levels", "choices", "fixed"):
+        for name, values in design.get(key, {}).items():
+            problems += _values_problems(f"design.{key}.{name}", name, values)
+    material = config.get("material", {})
+    for name in ("youngsModulus", "poissonsRatio"):
+        if name in material:
+            problems += _values_problems(f"material.{name}", name, material[name])
+    for name, axis in config.get("screening", {}).get("axes", {}).items():
+        problems += _values_problems(f"screening.axes.{name}", name, list(axis[:2]))
+    for i, candidate in enumerate(config.get("discrepancy", {}).get("candidates", [])):
+        problems += _candidate_problems(i, candidate)
+    application = config.get("application", {})
+    for name, value in (application.get("parameters") or {}).items():
+        problems += _values_problems(f"application.parameters.{name}", name, value)
+    if application.get("wall_friction") is not None:
+        problems += _values_problems(
+            "application.wall_friction", "wallFriction", application["wall_friction"]
+        )
+    return problems
+
+
 def validate_config(config: dict, source: str) -> dict:
-    """Validate a workflow configuration (``config/*.yaml``) in place and return it."""
-    return validate(config, "config.schema.yaml", source)
+    """Validate a workflow configuration (``config/*.yaml``) in place and return it.
+
+    The schema first (filling defaults), then the contact-parameter names and values
+    (:func:`parameter_problems`).
+
+    Raises
+    ------
+    ConfigError
+        Listing every violation with its dotted key path.
+    """
+    validate(config, "config.schema.yaml", source)
+    problems = parameter_problems(config)
+    if problems:
+        lines = "\n  ".join(problems)
+        raise ConfigError(f"{source}: invalid configuration:\n  {lines}")
+    return config
 
 
 def load_config(path: str | Path) -> dict:

@@ -1,14 +1,92 @@
 """Measured bulk data (``config/experiments/*.yaml``): loading, validation, acceptance targets."""
 
+import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import yaml
 
 from demcal.core.config import ConfigError, validate
-from demcal.identification.acceptance import MeasuredCondition
 
 SHEAR_OBSERVABLES = ("mu_psh", "mu_sh", "rho_b")
+
+
+def _format_load(value: float | None) -> str:
+    return "None" if value is None else f"{value:g}"
+
+
+@dataclass(frozen=True)
+class MeasuredCondition:
+    """Measured bulk values of one experiment at one load condition.
+
+    Parameters
+    ----------
+    values : Mapping[str, float]
+        Measured bulk values by output name (``mu_psh``, ``mu_sh`` [-], ``rho_b`` [kg/m^3],
+        ``aor`` [deg], ...). Must be non-empty, finite and non-zero (they are divisors).
+    uncertainties : Mapping[str, float], optional
+        Standard deviations of the measured values, same units; keys must be in ``values``.
+    normal_stress : float or None
+        Pre-shear normal stress [Pa] of a shear-cell condition; None for tests without load.
+    P : float or None
+        Shear load as a fraction of the pre-shear load [-]; given together with
+        ``normal_stress``.
+    name : str or None
+        Label of the condition; generated from the load when omitted.
+    """
+
+    values: Mapping[str, float]
+    uncertainties: Mapping[str, float] = field(default_factory=dict)
+    normal_stress: float | None = None
+    P: float | None = None
+    name: str | None = None
+
+    def __post_init__(self) -> None:
+        if not self.values:
+            raise ValueError(f"measured condition {self.label!r}: no measured values given")
+        for key, value in self.values.items():
+            if not math.isfinite(value) or value == 0.0:
+                raise ValueError(
+                    f"measured condition {self.label!r}: value of {key!r} must be finite and "
+                    f"non-zero, got {value!r}"
+                )
+        for key, value in self.uncertainties.items():
+            if key not in self.values:
+                raise KeyError(
+                    f"measured condition {self.label!r}: uncertainty given for {key!r} "
+                    f"which has no measured value"
+                )
+            if not math.isfinite(value) or value < 0.0:
+                raise ValueError(
+                    f"measured condition {self.label!r}: uncertainty of {key!r} must be finite "
+                    f"and >= 0, got {value!r}"
+                )
+        if (self.normal_stress is None) != (self.P is None):
+            raise ValueError(
+                f"measured condition {self.label!r}: normal_stress and P must be given together"
+            )
+        if self.normal_stress is not None and not self.normal_stress > 0.0:
+            raise ValueError(
+                f"measured condition {self.label!r}: normal_stress must be > 0 Pa, "
+                f"got {self.normal_stress!r}"
+            )
+
+    @property
+    def label(self) -> str:
+        """Name of the condition, e.g. ``"normal_stress=10070,P=1"``."""
+        if self.name is not None:
+            return self.name
+        if self.normal_stress is None and self.P is None:
+            return "+".join(self.values)
+        return f"normal_stress={_format_load(self.normal_stress)},P={_format_load(self.P)}"
+
+    @property
+    def load(self) -> dict[str, float]:
+        """Load features of the condition (``normal_stress`` [Pa], ``P`` [-]); empty if none."""
+        if self.normal_stress is None or self.P is None:
+            return {}
+        return {"normal_stress": float(self.normal_stress), "P": float(self.P)}
 
 
 @dataclass

@@ -1,17 +1,14 @@
 """Physical validity of DEM cases before any engine run.
 
-Each design row is checked against the limits LIGGGHTS 3.8 itself enforces or that the physics
-requires (SI units):
+Each design row is checked against the bounds of :data:`demcal.core.parameters.PARAMETERS`
+(the limits LIGGGHTS 3.8 itself enforces or that the physics requires, e.g.
+coefficientRestitution in (0.05, 1]), with two bounds that depend on the rules:
 
 =============================  ==============================================
-coefficientFriction            >= 0
-coefficientRollingFriction     >= 0
-coefficientRestitution         in (0.05, 1]  (LIGGGHTS rejects values outside)
-density                        > 0
 youngsModulus                  >= 5e6 Pa (LIGGGHTS rejects softer particles unless
-                               ``soft_particles yes``; then > 0)
-poissonsRatio                  in (0, 0.5)
-cohesionEnergyDensity          >= 0
+                               ``soft_particles yes``; then > 0) and <= 1e9 Pa
+                               (LIGGGHTS rejects stiffer ones unless
+                               ``hard_particles yes``, which the decks never set)
 dCylDp                         >= the caller's minimum (> 0 when none is given)
 =============================  ==============================================
 
@@ -23,23 +20,27 @@ the problem (or None when the row is fine).
 from __future__ import annotations
 
 import math
-import numbers
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import pandas as pd
 
+from demcal.core.parameters import (
+    CONTACT_PARAMETERS,
+    MAX_YOUNGS_MODULUS,
+    MIN_YOUNGS_MODULUS,
+    PARAMETERS,
+    Interval,
+    out_of_bounds,
+)
+
 __all__ = [
-    "MIN_YOUNGS_MODULUS",
     "CaseValidationError",
     "MissingColumnError",
     "ValidationRules",
     "validate_case",
     "validate_design",
 ]
-
-#: Smallest Young's modulus LIGGGHTS accepts without ``soft_particles yes``, Pa.
-MIN_YOUNGS_MODULUS = 5.0e6
 
 CASE_ID = "case_id"
 ExtraCheck = Callable[[Mapping[str, object]], str | None]
@@ -92,12 +93,7 @@ class ValidationRules:
 
     min_dCylDp: float | None = None
     allow_soft_particles: bool = False
-    required: tuple[str, ...] = (
-        "coefficientFriction",
-        "coefficientRollingFriction",
-        "coefficientRestitution",
-        "density",
-    )
+    required: tuple[str, ...] = CONTACT_PARAMETERS
     extra_checks: tuple[ExtraCheck, ...] = ()
 
     def required_fields(self) -> tuple[str, ...]:
@@ -108,46 +104,15 @@ class ValidationRules:
         return tuple(dict.fromkeys(fields))
 
 
-def _fmt(x: float) -> str:
-    return "inf" if math.isinf(x) else f"{x:.12g}"
-
-
-@dataclass(frozen=True)
-class _Interval:
-    low: float
-    high: float
-    low_closed: bool
-    high_closed: bool
-
-    def contains(self, x: float) -> bool:
-        above = x >= self.low if self.low_closed else x > self.low
-        below = x <= self.high if self.high_closed else x < self.high
-        return above and below
-
-    def __str__(self) -> str:
-        left = "[" if self.low_closed else "("
-        right = "]" if self.high_closed and not math.isinf(self.high) else ")"
-        return f"{left}{_fmt(self.low)}, {_fmt(self.high)}{right}"
-
-
-def _limits(rules: ValidationRules) -> dict[str, _Interval]:
-    inf = math.inf
-    min_y = MIN_YOUNGS_MODULUS if not rules.allow_soft_particles else 0.0
-    min_d = rules.min_dCylDp
-    return {
-        "coefficientFriction": _Interval(0.0, inf, True, False),
-        "coefficientRollingFriction": _Interval(0.0, inf, True, False),
-        "coefficientRestitution": _Interval(0.05, 1.0, False, True),
-        "density": _Interval(0.0, inf, False, False),
-        "youngsModulus": _Interval(min_y, inf, not rules.allow_soft_particles, False),
-        "poissonsRatio": _Interval(0.0, 0.5, False, False),
-        "cohesionEnergyDensity": _Interval(0.0, inf, True, False),
-        "dCylDp": (
-            _Interval(0.0, inf, False, False)
-            if min_d is None
-            else _Interval(float(min_d), inf, True, False)
-        ),
-    }
+def _limits(rules: ValidationRules) -> dict[str, Interval]:
+    limits = {name: p.bounds for name, p in PARAMETERS.items()}
+    lowest = 0.0 if rules.allow_soft_particles else MIN_YOUNGS_MODULUS
+    limits["youngsModulus"] = Interval(
+        lowest, MAX_YOUNGS_MODULUS, not rules.allow_soft_particles, True
+    )
+    if rules.min_dCylDp is not None:
+        limits["dCylDp"] = Interval(float(rules.min_dCylDp), math.inf, True, False)
+    return limits
 
 
 def _case_problems(row: Mapping[str, object], rules: ValidationRules) -> list[str]:
@@ -156,15 +121,9 @@ def _case_problems(row: Mapping[str, object], rules: ValidationRules) -> list[st
     for name, interval in _limits(rules).items():
         if name not in row:
             continue
-        value = row[name]
-        if isinstance(value, bool) or not isinstance(value, numbers.Real):
-            problems.append(f"{name} = {value!r} is not a number")
-            continue
-        x = float(value)
-        if math.isnan(x):
-            problems.append(f"{name} = nan is not a number")
-        elif not interval.contains(x):
-            problems.append(f"{name} = {_fmt(x)} is outside {interval}")
+        problem = out_of_bounds(name, row[name], interval)
+        if problem:
+            problems.append(problem)
     for check in rules.extra_checks:
         message = check(row)
         if message:

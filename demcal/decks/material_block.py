@@ -4,7 +4,8 @@ from collections.abc import Mapping
 from typing import Any
 
 from demcal.decks.render import template_environment
-from demcal.virtual_tests.shear_cell.setup import material_setup, size_distribution
+from demcal.particles.material import material_setup
+from demcal.particles.size_distribution import size_distribution
 
 
 def material_block_text(

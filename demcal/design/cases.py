@@ -8,11 +8,14 @@ carry these ids, never floats.
 
 import re
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-from demcal.design.table import build_design
+from demcal.core.provenance import write_sidecar
+from demcal.design.build import build_design
+from demcal.design.table import write_design_table
 
 TESTS = ("shear_cell", "angle_of_repose")
 _SHEAR_KEY = re.compile(r"[A-Za-z0-9]+_s(?P<s>\d+)(_p(?P<p>\d+))?")
@@ -35,6 +38,28 @@ def design_spec(section: Mapping[str, Any]) -> dict[str, Any]:
 def design_from_config(config: Mapping[str, Any]) -> pd.DataFrame:
     """The design table (one row per parameter set) of a validated configuration."""
     return build_design(design_spec(config["design"]))
+
+
+def write_design(config: Mapping[str, Any], path: str | Path) -> pd.DataFrame:
+    """Write the design table of a validated configuration as CSV with a provenance sidecar.
+
+    Parameters
+    ----------
+    config : mapping
+        The validated configuration (its ``design`` section and seed).
+    path : str or Path
+        Output CSV; parent directories are created. The sidecar is ``<path>.json``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The design table, one row per parameter set.
+    """
+    table = design_from_config(config)
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    write_design_table(table, path)
+    write_sidecar(path, config, seed=int(config["design"]["seed"]))
+    return table
 
 
 def case_ids(config: Mapping[str, Any], design: pd.DataFrame, test: str) -> list[str]:
@@ -112,6 +137,34 @@ def verification_case(
     if test == "shear_cell":
         row.update(load_condition(config, key))
     return row
+
+
+#: Name of the engine of ``engine.command`` when ``verification.engines`` is empty.
+CONFIGURED_ENGINE = "configured"
+
+
+def verification_engines(config: Mapping[str, Any]) -> dict[str, str]:
+    """The engines of the verification runs: name -> command template, in configured order.
+
+    Parameters
+    ----------
+    config : mapping
+        The validated configuration.
+
+    Returns
+    -------
+    dict
+        ``verification.engines``, or ``{"configured": engine.command}`` when that is empty.
+    """
+    engines = dict((config.get("verification") or {}).get("engines") or {})
+    return engines or {CONFIGURED_ENGINE: config["engine"]["command"]}
+
+
+def verification_threads(config: Mapping[str, Any]) -> int:
+    """Threads or MPI ranks of one verification run (``verification.threads`` or
+    ``engine.threads``)."""
+    threads = (config.get("verification") or {}).get("threads")
+    return int(threads if threads is not None else config["engine"]["threads"])
 
 
 def verification_case_ids(config: Mapping[str, Any], test: str) -> list[str]:

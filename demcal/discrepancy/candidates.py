@@ -24,8 +24,9 @@ from typing import Any
 import pandas as pd
 
 from demcal.core.experiments import Experiment
+from demcal.core.parameters import CONTACT_PARAMETERS
+from demcal.design.build import build_design
 from demcal.design.cases import design_spec, load_condition, shear_suffixes
-from demcal.design.table import build_design
 
 __all__ = [
     "REFERENCE_CASE",
@@ -45,12 +46,7 @@ __all__ = [
 #: Case id of the probe run at theta* with no effect added.
 REFERENCE_CASE = "ref"
 _NAME = re.compile(r"^[a-z][a-z0-9]*$")
-_CONTACT = (
-    "coefficientFriction",
-    "coefficientRollingFriction",
-    "coefficientRestitution",
-    "density",
-)
+_CONTACT = CONTACT_PARAMETERS
 
 
 @dataclass(frozen=True)

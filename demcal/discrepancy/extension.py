@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import math
-import numbers
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -18,52 +17,20 @@ from typing import Any
 import pandas as pd
 
 from demcal.bulk.dataset import usable
+from demcal.core.provenance import write_sidecar
 from demcal.discrepancy.candidates import Candidate
+from demcal.discrepancy.run_results import read_runs
+from demcal.discrepancy.runs import named_candidate
+from demcal.surrogates.data_split import split_indices
+from demcal.surrogates.hidden_size_sweep import sweep_hidden_sizes
 from demcal.surrogates.metrics import regression_metrics
-from demcal.surrogates.network import split_indices, sweep_hidden_sizes
 from demcal.surrogates.training import INPUTS, TEST_OF, varying_features
 
 __all__ = [
     "extended_training_data",
-    "read_runs",
     "train_extended_surrogate",
+    "write_extended_dataset",
 ]
-
-_TEST_NAMES = {"repose": "angle_of_repose"}
-
-
-def read_runs(bulk_files: Iterable[str | Path]) -> pd.DataFrame:
-    """Bulk rows of discrepancy runs with every numeric and text field of their case row.
-
-    Each ``bulk.csv`` (written by the ``bulk_case`` rule) is joined with the ``case`` entry of
-    the ``case.json`` beside it, so parameters the tidy dataset does not know (a magnitude set
-    through the configuration, the candidate's name) are kept.
-
-    Raises
-    ------
-    FileNotFoundError
-        When a ``case.json`` is missing (names the file).
-    """
-    frames = []
-    for path in bulk_files:
-        path = Path(path)
-        info_path = path.parent / "case.json"
-        if not info_path.is_file():
-            raise FileNotFoundError(f"{info_path}: case description of {path} is missing")
-        case = json.loads(info_path.read_text())["case"]
-        rows = pd.read_csv(path)
-        for key, value in case.items():
-            if key == "case_id" or (key in ("normal_stress", "P") and key in rows):
-                continue
-            if isinstance(value, bool) or not isinstance(value, numbers.Real | str):
-                continue
-            rows[key] = value
-        rows["run"] = path.parent.name
-        rows["test"] = rows["test"].replace(_TEST_NAMES)
-        frames.append(rows)
-    if not frames:
-        return pd.DataFrame()
-    return pd.concat(frames, ignore_index=True, sort=False)
 
 
 def extended_training_data(
@@ -80,9 +47,10 @@ def extended_training_data(
     base : DataFrame
         The current design's tidy dataset (effect absent).
     probes : DataFrame
-        Probe runs (:func:`read_runs`); the reference and the candidate's levels are kept.
+        Probe runs (:func:`demcal.discrepancy.run_results.read_runs`); the reference and the
+        candidate's levels are kept.
     extended : DataFrame
-        Runs of the extended design (:func:`read_runs`).
+        Runs of the extended design (:func:`demcal.discrepancy.run_results.read_runs`).
     candidate : Candidate
         The added effect.
     tests : sequence of str
@@ -118,6 +86,50 @@ def extended_training_data(
     data = pd.concat(parts, ignore_index=True, sort=False)
     if data[param].isna().any():
         raise ValueError(f"extended model: rows without a value of {param!r}")
+    return data
+
+
+def write_extended_dataset(
+    config: Mapping[str, Any],
+    ranking_record_path: str | Path,
+    dataset_path: str | Path,
+    probe_files: Iterable[str | Path],
+    extended_files: Iterable[str | Path],
+    tests: Sequence[str],
+    out_path: str | Path,
+) -> pd.DataFrame:
+    """Write the training data of the model extended by the named effect (with sidecar).
+
+    Parameters
+    ----------
+    config : mapping
+        The validated configuration.
+    ranking_record_path : path
+        Record of the ranking (its ``winner`` is the added effect).
+    dataset_path : path
+        The current design's tidy dataset.
+    probe_files, extended_files : iterable of path
+        ``bulk.csv`` of the probe runs and of the extended design's runs.
+    tests : sequence of str
+        Tests to keep.
+    out_path : path
+        The CSV to write.
+
+    Returns
+    -------
+    DataFrame
+        The rows written (:func:`extended_training_data`).
+    """
+    candidate = named_candidate(config, ranking_record_path)
+    data = extended_training_data(
+        pd.read_csv(dataset_path),
+        read_runs(probe_files),
+        read_runs(extended_files),
+        candidate,
+        list(tests),
+    )
+    data.to_csv(out_path, index=False, float_format="%.10g")
+    write_sidecar(out_path, config, extra={"rows": len(data)})
     return data
 
 

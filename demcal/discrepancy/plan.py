@@ -25,6 +25,7 @@ from demcal.discrepancy.candidates import (
     probe_runs,
     run_suffixes,
 )
+from demcal.discrepancy.observations import OBSERVABLES
 
 __all__ = ["VERIFICATION_CASE", "DiscrepancyPlan", "measured_observables"]
 
@@ -33,11 +34,11 @@ VERIFICATION_CASE = "verify"
 
 
 def measured_observables(experiment: Experiment) -> list[str]:
-    """Bulk values that were measured, in the order mu_psh, mu_sh, rho_b, aor."""
+    """Bulk values that were measured, in the order of ``OBSERVABLES``."""
     seen = {name for cond in experiment.shear_conditions for name in cond.values}
     if experiment.angle_of_repose is not None:
         seen.add("aor")
-    return [o for o in ("mu_psh", "mu_sh", "rho_b", "aor") if o in seen]
+    return [o for o in OBSERVABLES if o in seen]
 
 
 @dataclass(frozen=True)

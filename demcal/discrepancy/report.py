@@ -14,7 +14,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from demcal.discrepancy.find import FindResult, format_stress
+from demcal.discrepancy.find import FindResult
+from demcal.discrepancy.observations import format_stress
 
 __all__ = [
     "KEY_COLUMNS",

@@ -11,7 +11,6 @@ from typing import Any
 import pandas as pd
 
 from demcal.core.rule_log import rule_log
-from demcal.decks.render import render_case
 from demcal.discrepancy.candidates import (
     REFERENCE_CASE,
     Candidate,
@@ -19,8 +18,9 @@ from demcal.discrepancy.candidates import (
     case_setup,
     parse_candidates,
 )
+from demcal.virtual_tests.deck import render_case
 
-__all__ = ["candidate_by_name", "discrepancy_case", "render_discrepancy_run"]
+__all__ = ["candidate_by_name", "discrepancy_case", "named_candidate", "render_discrepancy_run"]
 
 
 def candidate_by_name(config: Mapping[str, Any], name: str) -> Candidate:
@@ -35,6 +35,12 @@ def candidate_by_name(config: Mapping[str, Any], name: str) -> Candidate:
         if cand.name == name:
             return cand
     raise KeyError(f"discrepancy.candidates: no candidate named {name!r}")
+
+
+def named_candidate(config: Mapping[str, Any], ranking_record: str | Path) -> Candidate:
+    """The catalogue entry of the effect the ranking named (``winner`` of its JSON record)."""
+    record = json.loads(Path(ranking_record).read_text())
+    return candidate_by_name(config, record["winner"])
 
 
 def discrepancy_case(

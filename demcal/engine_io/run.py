@@ -16,7 +16,7 @@ def engine_command(template: str, deck: str, threads: int) -> list[str]:
     Parameters
     ----------
     template : str
-        E.g. ``"dem_engine -in {deck}"`` or ``"mpirun -np {threads} lmp_auto -in {deck}"``.
+        E.g. ``"dem_engine -in {deck}"`` or ``"mpirun -np {threads} liggghts -in {deck}"``.
     deck : str
         Deck file name, relative to the case directory.
     threads : int
@@ -44,6 +44,24 @@ def engine_command(template: str, deck: str, threads: int) -> list[str]:
     return cmd
 
 
+def error_lines(case_dir: Path) -> list[str]:
+    """The ``ERROR`` lines of a finished run, in the order the engine wrote them.
+
+    The bundled engine writes its errors to standard error; LIGGGHTS 3.8 writes them to standard
+    output and its log file (``ERROR: ...`` or, under MPI, ``ERROR on proc N: ...``), so all three
+    files are read and a line seen twice is kept once.
+    """
+    seen: dict[str, None] = {}
+    for name in ("engine.err", "engine.out", "log.liggghts"):
+        path = case_dir / name
+        if not path.is_file():
+            continue
+        for line in path.read_text(errors="replace").splitlines():
+            if line.startswith("ERROR"):
+                seen.setdefault(line.strip(), None)
+    return list(seen)
+
+
 def run_deck(case_dir: str | Path, deck: str, template: str, threads: int) -> dict:
     """Run ``deck`` in ``case_dir`` and write ``status.json`` there.
 
@@ -65,11 +83,7 @@ def run_deck(case_dir: str | Path, deck: str, template: str, threads: int) -> di
         proc = subprocess.run(cmd, cwd=case_dir, stdout=out, stderr=err, env=env, check=False)
         returncode = proc.returncode
     seconds = time.monotonic() - start
-    errors = [
-        line.strip()
-        for line in (case_dir / "engine.err").read_text().splitlines()
-        if line.startswith("ERROR")
-    ]
+    errors = error_lines(case_dir)
     status = {
         "status": "ok" if returncode == 0 else "failed",
         "returncode": returncode,

@@ -16,7 +16,9 @@ import torch
 
 from demcal.core.experiments import Experiment
 from demcal.identification.acceptance import within_tolerance
-from demcal.identification.screening import Stage, draw_axes, screen, stage_from_condition
+from demcal.identification.candidate_grid import draw_axes
+from demcal.identification.screening import screen
+from demcal.identification.screening_stages import Stage, stage_from_condition
 from demcal.identification.statistics import (
     combine_statistics,
     identified_parameters,

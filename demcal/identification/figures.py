@@ -16,7 +16,8 @@ import pandas as pd
 from matplotlib.colors import ListedColormap
 from matplotlib.patches import Patch
 
-from demcal.identification.statistics import PARAMETER_LABELS, dominant_bin_map
+from demcal.core.parameters import PARAMETER_LABELS
+from demcal.identification.statistics import dominant_bin_map
 
 _BIN_COLOURS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02")
 

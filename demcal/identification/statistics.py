@@ -15,19 +15,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from demcal.core.parameters import PARAMETER_LABELS
+
 STATISTICS = ("mean", "sd", "max", "range", "sd/range")
 """Per-parameter rows of Table 5, in order."""
 
 VALID_GROUP = "valid sets"
 """First index level of the two count rows of Table 5 (``number`` and ``percent``)."""
 
-PARAMETER_LABELS: dict[str, str] = {
-    "coefficientFriction": "mu_s (-)",
-    "coefficientRollingFriction": "mu_r (-)",
-    "coefficientRestitution": "COR (-)",
-    "density": "rho_p (kg/m^3)",
-}
-"""Short labels of the contact parameters used in tables and figures."""
 
 
 def _check_columns(valid: pd.DataFrame, parameters: Sequence[str], what: str) -> None:

@@ -1,72 +1,111 @@
-"""The loop the paper left open: DEM bulk values at the identified set against the measurements."""
+"""The loop the paper left open: DEM bulk values at the identified set against the measurements,
+on one engine or several side by side."""
+
+from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
+import numpy as np
 import pandas as pd
 
 from demcal.core.experiments import Experiment
+from demcal.identification.acceptance import relative_deviation, within_tolerance
+
+#: Column of the largest relative difference between engines (two engines or more).
+ENGINE_DIFFERENCE = "engine_difference"
+
+
+def engine_columns(engine: str) -> tuple[str, str, str]:
+    """Columns of one engine in the verification table: value, deviation, within tolerance."""
+    return f"dem_{engine}", f"deviation_{engine}", f"within_tolerance_{engine}"
+
+
+def _observations(experiment: Experiment) -> list[dict]:
+    """The measured observables in table order: name, load, measured value and sd."""
+    rows = []
+    for cond in experiment.shear_conditions:
+        for name, measured in cond.values.items():
+            sd = cond.uncertainties.get(name)
+            rows.append(
+                {
+                    "observable": name,
+                    "normal_stress": cond.normal_stress,
+                    "P": cond.P,
+                    "measured": measured,
+                    "measured_sd": sd if sd is not None else math.nan,
+                }
+            )
+    if experiment.angle_of_repose is not None:
+        sd = experiment.angle_of_repose_sd
+        rows.append(
+            {
+                "observable": "aor",
+                "normal_stress": math.nan,
+                "P": math.nan,
+                "measured": experiment.angle_of_repose,
+                "measured_sd": sd if sd is not None else math.nan,
+            }
+        )
+    return rows
+
+
+def _dem_value(runs: pd.DataFrame, row: Mapping) -> float:
+    """The DEM value of the observable of ``row`` in ``runs`` (NaN when no run matches)."""
+    name = row["observable"]
+    if name == "aor":
+        aor = runs[runs["test"] == "angle_of_repose"]
+        return float(aor["aor"].iloc[0]) if len(aor) else math.nan
+    shear = runs[runs["test"] == "shear_cell"]
+    stress, p = row["normal_stress"], row["P"]
+    match = shear[
+        (shear["normal_stress"] - stress).abs().lt(1e-6 * stress) & (shear["P"] - p).abs().lt(1e-9)
+    ]
+    return float(match[name].iloc[0]) if len(match) and name in match else math.nan
 
 
 def verification_table(
-    runs: pd.DataFrame, experiment: Experiment, tolerance: float
+    runs: Mapping[str, pd.DataFrame], experiment: Experiment, tolerance: float
 ) -> pd.DataFrame:
-    """One row per measured observable: measured, DEM at the identified set, deviation, within?
+    """One row per measured observable: measured, each engine's DEM value and deviation.
 
     Parameters
     ----------
-    runs : DataFrame
-        Bulk rows of the verification cases (tidy layout of ``demcal.bulk.dataset``).
+    runs : mapping of str to DataFrame
+        Per engine name (in the order of the columns), the bulk rows of its verification cases
+        (tidy layout of ``demcal.bulk.dataset``).
     experiment : Experiment
         The measurements.
     tolerance : float
         Acceptance tolerance |1 - num/exp| (eqs. 3-4).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns ``observable``, ``normal_stress``, ``P``, ``measured``, ``measured_sd``, then per
+        engine ``dem_<engine>``, ``deviation_<engine>`` (|1 - dem/measured|) and
+        ``within_tolerance_<engine>``; with two engines or more, ``engine_difference``: the
+        largest |1 - dem_other/dem_first| over the other engines, NaN when a value is missing
+        (or the first engine's value is 0).
+        A missing DEM value (no run at that load) is NaN and never within the tolerance.
     """
-    rows = []
-    shear = runs[runs["test"] == "shear_cell"]
-    for cond in experiment.shear_conditions:
-        match = shear[
-            (shear["normal_stress"] - cond.normal_stress).abs().lt(1e-6 * cond.normal_stress)
-            & (shear["P"] - cond.P).abs().lt(1e-9)
-        ]
-        for name, measured in cond.values.items():
-            dem = float(match[name].iloc[0]) if len(match) else math.nan
-            rows.append(
-                _row(
-                    name,
-                    cond.normal_stress,
-                    cond.P,
-                    measured,
-                    cond.uncertainties.get(name),
-                    dem,
-                    tolerance,
-                )
+    if not runs:
+        raise ValueError("no engine: nothing to verify")
+    rows = _observations(experiment)
+    for row in rows:
+        values = []
+        for engine, frame in runs.items():
+            value, deviation, within = engine_columns(engine)
+            dem = _dem_value(frame, row)
+            name = row["observable"]
+            accepted = within_tolerance({name: np.array([dem])}, {name: row["measured"]}, tolerance)
+            row[value] = dem
+            row[deviation] = float(relative_deviation(dem, row["measured"]))
+            row[within] = bool(accepted[0])
+            values.append(dem)
+        if len(values) > 1:
+            first = values[0]
+            row[ENGINE_DIFFERENCE] = (
+                float(np.max(relative_deviation(values[1:], first))) if first != 0.0 else math.nan
             )
-    if experiment.angle_of_repose is not None:
-        aor = runs[runs["test"] == "angle_of_repose"]
-        dem = float(aor["aor"].iloc[0]) if len(aor) else math.nan
-        rows.append(
-            _row(
-                "aor",
-                math.nan,
-                math.nan,
-                experiment.angle_of_repose,
-                experiment.angle_of_repose_sd,
-                dem,
-                tolerance,
-            )
-        )
     return pd.DataFrame(rows)
-
-
-def _row(name, stress, p, measured, sd, dem, tolerance) -> dict:
-    deviation = abs(1.0 - dem / measured) if math.isfinite(dem) else math.nan
-    return {
-        "observable": name,
-        "normal_stress": stress,
-        "P": p,
-        "measured": measured,
-        "measured_sd": sd if sd is not None else math.nan,
-        "dem_identified": dem,
-        "relative_deviation": deviation,
-        "within_tolerance": bool(deviation < tolerance) if math.isfinite(deviation) else False,
-    }

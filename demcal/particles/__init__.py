@@ -1,3 +1,4 @@
-"""Particles: size distributions, the material set-up and the time step that every virtual
-test and the application share.
+"""Particles: size distributions, the material set-up and the time step, and the run set-up
+(simulation box, output intervals, insertion seeds) that every virtual test and the application
+share.
 """

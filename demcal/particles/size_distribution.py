@@ -35,10 +35,14 @@ data than these six classes, so the plain lower-bound mapping is kept.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+
+from demcal.core import config_values
+from demcal.core.config_values import SetupError
 
 __all__ = [
     "SINTER_FINES_SIEVE_MM",
@@ -46,6 +50,7 @@ __all__ = [
     "from_sieve_analysis",
     "monodisperse",
     "sinter_fines",
+    "size_distribution",
 ]
 
 #: Sieve analysis of the sinter fines: (sieve opening in mm, mass fraction retained).
@@ -239,3 +244,40 @@ def sinter_fines(scale: float = 1.0, n_largest: int | None = None) -> SizeDistri
     if scale != 1.0:
         dist = dist.scaled(scale)
     return dist
+
+
+def size_distribution(particles: Mapping[str, Any]) -> SizeDistribution:
+    """Particle size distribution of the ``particles`` configuration section.
+
+    Parameters
+    ----------
+    particles : mapping
+        ``distribution`` ("monodisperse" or "sinter_fines"), ``radius`` (m, monodisperse),
+        ``scale`` (-, factor on the sinter-fines radii) and ``classes`` (number of the largest
+        sieve classes kept, 1-6).
+
+    Returns
+    -------
+    SizeDistribution
+        Radii (m) and mass fractions.
+
+    Raises
+    ------
+    SetupError
+        A value out of range (the message names the key).
+    """
+    get = config_values.required
+    positive = config_values.positive_value
+    kind = get(particles, "distribution", "particles")
+    if kind == "monodisperse":
+        return monodisperse(positive(get(particles, "radius", "particles"), "particles.radius"))
+    if kind == "sinter_fines":
+        scale = positive(get(particles, "scale", "particles"), "particles.scale")
+        classes = int(get(particles, "classes", "particles"))
+        if not 1 <= classes <= 6:
+            raise SetupError(f"configuration: 'particles.classes' must be in 1..6, got {classes}")
+        return sinter_fines(scale=scale, n_largest=classes)
+    raise SetupError(
+        f"configuration: 'particles.distribution' must be 'monodisperse' or 'sinter_fines', "
+        f"got {kind!r}"
+    )

@@ -12,8 +12,8 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd
 
+from demcal.surrogates.hidden_size_sweep import select_by_test_r2, select_by_validation
 from demcal.surrogates.metrics import regression_metrics
-from demcal.surrogates.network import select_by_test_r2, select_by_validation
 
 
 def parity_plot(y_true: npt.ArrayLike, y_pred: npt.ArrayLike, label: str, path: str | Path) -> Path:

@@ -9,10 +9,18 @@ from typing import Any
 import pandas as pd
 
 from demcal.bulk.dataset import PARAMETERS, usable
+from demcal.core.provenance import write_sidecar
 from demcal.surrogates.baselines import bayesian_linear_regression, gaussian_process_regression
+from demcal.surrogates.data_split import split_groups
 from demcal.surrogates.figures import parity_plot, r2_vs_hidden_size
+from demcal.surrogates.hidden_size_sweep import (
+    SweepResult,
+    select_by_test_r2,
+    select_by_validation,
+    sweep_hidden_sizes,
+)
 from demcal.surrogates.metrics import method_comparison_table, regression_metrics, to_markdown
-from demcal.surrogates.network import MLPSurrogate, SweepResult, split_groups, sweep_hidden_sizes
+from demcal.surrogates.network import MLPSurrogate
 
 #: Candidate inputs per bulk value (paper section "Artificial Neural Networks").
 SHEAR_INPUTS = (*PARAMETERS, "normal_stress", "P")
@@ -126,6 +134,64 @@ def train_output(
         },
     )
     return TrainedSurrogate(output, features, sweep, table4, len(rows))
+
+
+def train_from_dataset(
+    dataset: str | Path,
+    output: str,
+    settings: Mapping[str, Any],
+    model: str | Path,
+    config: Mapping[str, Any],
+) -> TrainedSurrogate:
+    """Train the surrogate of ``output`` on the dataset file (:func:`train_output`).
+
+    Parameters
+    ----------
+    dataset : path
+        The tidy bulk dataset (CSV).
+    output : {"mu_psh", "mu_sh", "rho_b", "aor"}
+        The bulk value.
+    settings : mapping
+        The ``surrogate`` config section.
+    model : path
+        The network file (``model.pt``); every other artifact goes beside it, Table 4 with a
+        provenance sidecar ``table4.csv.json``.
+    config : mapping
+        The validated configuration (for the sidecar).
+    """
+    trained = train_output(pd.read_csv(dataset), output, settings, Path(model).parent)
+    write_sidecar(Path(model).parent / "table4.csv", config, seed=int(settings["seed"]))
+    return trained
+
+
+def write_table4_document(
+    outputs: Sequence[str],
+    tables: Sequence[str | Path],
+    sweeps: Sequence[str | Path],
+    markdown: str | Path,
+) -> None:
+    """Gather Table 4 of every bulk value and its hidden-size choices into one markdown file.
+
+    Parameters
+    ----------
+    outputs : sequence of str
+        The bulk values, in document order.
+    tables, sweeps : sequence of path
+        ``table4.csv`` and ``sweep.csv`` of each bulk value, in the order of ``outputs``.
+    markdown : path
+        The document.
+    """
+    parts = ["# Table 4: regression methods compared on the test set\n"]
+    for name, table, sweep in zip(outputs, tables, sweeps, strict=True):
+        t4 = pd.read_csv(table, index_col=0)
+        sw = pd.read_csv(sweep)
+        parts.append(
+            f"## {name}\n\nNetwork size chosen by generalisation-set error: "
+            f"{select_by_validation(sw)} hidden neurons; the paper's rule (best test R^2) "
+            f"would pick {select_by_test_r2(sw)}.\n\n{to_markdown(t4, float_format='.3g')}\n"
+        )
+    with open(markdown, "w") as fh:
+        fh.write("\n".join(parts))
 
 
 def load_surrogate(path: str | Path) -> tuple[MLPSurrogate, list[str]]:

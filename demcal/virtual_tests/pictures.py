@@ -16,7 +16,8 @@ import numpy as np
 import pyvista
 
 from demcal.bulk.values import MissingOutputError, read_case_record
-from demcal.engine_io.output import read_print_file, read_vtk_particles
+from demcal.engine_io.fix_output import read_print_file
+from demcal.engine_io.vtk_file import read_vtk_particles
 from demcal.virtual_tests.angle_of_repose.readout import angle_of_repose
 
 pyvista.OFF_SCREEN = True

@@ -233,6 +233,10 @@ TINY_SLURM_ARGS = (
 )
 # Run logs whose content includes wall-clock and CPU times.
 TIMED_FILES = {"engine.out", "log.liggghts"}
+#: Snakemake's benchmark records and the run-time table and figure drawn from them: times,
+#: memory and load of each run only.
+TIMED_FOLDERS = ("benchmarks",)
+TIMED_FIGURES = {"run_times.png", "run_times.csv"}
 
 
 def tiny_workdir(path: Path) -> Path:
@@ -258,14 +262,15 @@ def result_differences(local: Path, remote: Path) -> list[str]:
     """Files of two ``results/`` trees that differ, apart from timings.
 
     CSV tables are compared value by value without columns ending in 'seconds', JSON without
-    such keys, the engine's run logs only for presence, everything else byte by byte.
+    such keys, the engine's run logs, benchmark records and the run-time table and figure only for
+    presence, everything else byte by byte.
     """
     files_a = {p.relative_to(local) for p in local.rglob("*") if p.is_file()}
     files_b = {p.relative_to(remote) for p in remote.rglob("*") if p.is_file()}
     diffs = [f"only in one run: {p}" for p in sorted(files_a ^ files_b)]
     for rel in sorted(files_a & files_b):
         a, b = local / rel, remote / rel
-        if rel.name in TIMED_FILES:
+        if rel.name in TIMED_FILES | TIMED_FIGURES or rel.parts[0] in TIMED_FOLDERS:
             continue
         if rel.suffix == ".csv":
             fa, fb = pd.read_csv(a), pd.read_csv(b)

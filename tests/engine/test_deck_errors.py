@@ -129,3 +129,112 @@ def test_fuzzed_decks_never_crash_or_hang(tmp_path):
             assert res.stderr.strip().splitlines()[-1].startswith("ERROR: "), res.stderr
         outcomes.add(res.returncode)
     assert outcomes == {0, 1}
+
+
+# ---------------------------------------------------------------------------------------------
+# Decks that LIGGGHTS 3.8 rejects: the engine rejects them too, naming the file and line.
+
+FLOOR_WALL = """fix floor all wall/gran model hertz tangential history rolling_friction epsd2 &
+    primitive type 2 zplane -0.01
+"""
+WALL_MODEL = "model hertz tangential history rolling_friction epsd2"
+MESHES = (
+    "fix floor all mesh/surface file floor.stl type 2\n"
+    "fix roof all mesh/surface file roof.stl type 2\n"
+)
+# The valid counterpart: one mesh wall/gran fix lists every mesh.
+ONE_MESH_WALL = VALID.replace(
+    FLOOR_WALL, MESHES + f"fix walls all wall/gran {WALL_MODEL} mesh n_meshes 2 meshes floor roof\n"
+)
+
+# (name, deck, the line the engine names, its command, a word of its reason, what LIGGGHTS says
+# or None when it crashes instead of reporting)
+LIGGGHTS_REJECTS = [
+    (
+        "second mesh wall/gran",
+        VALID.replace(
+            FLOOR_WALL,
+            MESHES
+            + f"fix wfloor all wall/gran {WALL_MODEL} mesh n_meshes 1 meshes floor\n"
+            + f"fix wroof all wall/gran {WALL_MODEL} mesh n_meshes 1 meshes roof\n",
+        ),
+        "fix wroof",
+        "fix",
+        "second fix wall/gran with meshes",
+        "More than one wall of type 'mesh' is not supported",
+    ),
+    (
+        "wall/gran defined again without unfix",
+        ONE_MESH_WALL.replace(
+            "run 100\n",
+            "run 50\n"
+            + f"fix walls all wall/gran {WALL_MODEL} mesh n_meshes 1 meshes floor\n"
+            + "run 50\n",
+        ),
+        "meshes floor\n",
+        "fix",
+        "without unfix",
+        None,  # LIGGGHTS 3.8 ends with a segmentation fault
+    ),
+    (
+        "fix replaced by another style",
+        ONE_MESH_WALL.replace("run 100\n", "run 50\nfix grav all nve/sphere\nrun 50\n"),
+        "fix grav all nve/sphere",
+        "fix",
+        "another style",
+        "Replacing a fix, but new style != old style",
+    ),
+]
+
+
+def _plate_stl(half: float, z: float) -> str:
+    corners = [(-half, -half), (half, -half), (half, half), (-half, half)]
+    facets = []
+    for a, b, c in ((0, 1, 2), (0, 2, 3)):
+        vertices = "".join(
+            f"      vertex {corners[k][0]!r} {corners[k][1]!r} {z!r}\n" for k in (a, b, c)
+        )
+        facets.append(f"  facet normal 0 0 1\n    outer loop\n{vertices}    endloop\n  endfacet\n")
+    return "solid plate\n" + "".join(facets) + "endsolid plate\n"
+
+
+def _write_meshes(directory):
+    (directory / "floor.stl").write_text(_plate_stl(0.04, -0.01))
+    (directory / "roof.stl").write_text(_plate_stl(0.04, 0.04))
+
+
+@pytest.mark.liggghts
+def test_one_mesh_wall_listing_every_mesh_runs_on_both_engines(tmp_path):
+    from tests.liggghts.conftest import require_liggghts, run_liggghts
+
+    require_liggghts()
+    _write_meshes(tmp_path)
+    res = run_deck(tmp_path, ONE_MESH_WALL)
+    assert res.returncode == 0, res.stderr
+    lig = run_liggghts(tmp_path, "in.deck", timeout=120)
+    assert lig.returncode == 0, lig.describe()
+
+
+@pytest.mark.liggghts
+@pytest.mark.parametrize(
+    ("name", "text", "needle", "command", "reason", "liggghts_says"),
+    LIGGGHTS_REJECTS,
+    ids=[case[0] for case in LIGGGHTS_REJECTS],
+)
+def test_decks_liggghts_rejects_are_rejected_with_file_and_line(
+    tmp_path, name, text, needle, command, reason, liggghts_says
+):
+    from tests.liggghts.conftest import require_liggghts, run_liggghts
+
+    require_liggghts()
+    _write_meshes(tmp_path)
+    res = run_deck(tmp_path, text)
+    assert res.returncode == 1, f"{name}: the engine accepted the deck\n{res.stdout[-1500:]}"
+    err = res.stderr.strip().splitlines()[-1]
+    lines = [n for n, line in enumerate(text.splitlines(), 1) if needle.strip() in line]
+    assert err.startswith(f"ERROR: in.deck:{lines[-1]}: {command}: "), err
+    assert reason in err, err
+    lig = run_liggghts(tmp_path, "in.deck", timeout=120)
+    assert lig.returncode != 0 or "ERROR" in lig.output, f"{name}: LIGGGHTS accepted the deck"
+    if liggghts_says is not None:
+        assert liggghts_says in lig.output, lig.describe()

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from demcal.engine_io.output import read_dump_last
+from demcal.engine_io.dump_file import read_dump_last
 
 from .conftest import header, material_block, run_engine
 

@@ -13,7 +13,8 @@ pytestmark = pytest.mark.engine
 
 def test_cpp_unit_tests_pass():
     binary = ROOT / "build" / "engine" / "dem_engine_tests"
-    assert binary.is_file(), "build the engine first (make engine)"
+    if not binary.is_file():
+        pytest.fail(f"{binary} not found; run `make engine`", pytrace=False)
     res = subprocess.run(
         [str(binary)], capture_output=True, text=True, timeout=300, cwd=Path("/tmp")
     )

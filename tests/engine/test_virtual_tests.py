@@ -13,6 +13,7 @@ Typical values on the tiny profile: angle of repose 12-25 deg, mu_psh
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 from collections.abc import Iterable
@@ -24,8 +25,10 @@ import pytest
 
 from demcal.bulk.values import extract
 from demcal.core.config import load_config
-from demcal.decks.render import DECK_NAMES, render_case
+from demcal.engine_io.fix_output import read_print_file
+from demcal.virtual_tests.deck import DECK_NAMES, render_case
 from tests.engine.conftest import engine_path
+from tests.figures import bbox, colour_mask, distinct_colours, ink, read_png
 
 pytestmark = pytest.mark.engine
 
@@ -70,10 +73,7 @@ def _run_all(engine: str, jobs: Iterable[tuple[str, Path]], parallel: int = 2) -
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """Renders and runs every case of this module once; returns case directories by name."""
-    try:
-        engine = engine_path()
-    except RuntimeError as exc:
-        pytest.skip(str(exc))
+    engine = engine_path()  # fails, naming the places looked at, when the engine is missing
     root = tmp_path_factory.mktemp("virtual")
     stress = _settings()["shear_cell"]["normal_stresses"][0]
     shear = {**BASE, "normal_stress": stress}
@@ -156,38 +156,108 @@ def test_bulk_density_scales_with_particle_density(runs: dict[str, Path]) -> Non
     assert 0.45 < light["rho_b"] / 2500.0 < 0.65
 
 
-def test_mu_sh_below_mu_psh_when_the_load_is_reduced(runs: dict[str, Path]) -> None:
-    # Cohesionless spheres, P = 0.8: the freshly compressed bed reaches a peak in the
-    # pre-shear; after unloading, the shear at the lower load stays below it.
+def test_unloading_does_not_weaken_the_steady_shear(runs: dict[str, Path]) -> None:
+    # Cohesionless spheres, P = 0.8: the steady (critical-state) stress ratio of cohesionless
+    # spheres does not depend on the normal stress, and an over-consolidated sample is not
+    # weaker than a normally consolidated one. So mu_sh after unloading is not below mu_psh
+    # beyond the seed-to-seed scatter of the paired difference (LIGGGHTS 3.8 on the same tiny
+    # deck gives mu_psh 0.82, mu_sh 0.85).
     rows = [_shear(runs, f"shear_seed{s}") for s in SEEDS]
-    mu_psh = np.array([r["mu_psh"] for r in rows])
-    mu_sh = np.array([r["mu_sh"] for r in rows])
     assert all(r["P"] == P_TRENDS for r in rows)
-    assert mu_sh.mean() < mu_psh.mean() - 0.05
-    assert np.sum(mu_sh < mu_psh) >= 3
+    diff = np.array([r["mu_sh"] - r["mu_psh"] for r in rows])
+    sem = diff.std(ddof=1) / np.sqrt(len(diff))
+    assert diff.mean() > -2.0 * sem, (diff, sem)
 
 
 def test_load_condition_and_flags_in_the_table(runs: dict[str, Path]) -> None:
     table = extract("shear_cell", runs["shear_seed7"])
     row = table.iloc[0]
     assert (row["normal_stress"], row["P"], row["status"]) == (2029.0, P_TRENDS, "ok")
-    assert row["steady_psh"] in (True, False) and row["steady_sh"] in (True, False)
     assert row["mu_psh_sem"] < 0.05 and row["mu_sh_sem"] < 0.05
+    # The shear phase of at least three of the four fresh runs reaches a plateau. The tiny
+    # cell's pre-shear (0.1875 R of travel, as in the authors' decks) often ends while mu still
+    # drifts by a few per cent, so its flag is only checked for consistency with its reason.
+    rows = {s: _shear(runs, f"shear_seed{s}") for s in SEEDS}
+    assert sum(bool(r["steady_sh"]) for r in rows.values()) >= 3
+    # A flag says what the detector found: a plateau inside its phase that ends with it and
+    # covers at least the configured fraction of it.
+    for seed, r in rows.items():
+        record = json.loads((runs[f"shear_seed{seed}"] / "case.json").read_text())
+        dt, (cycle,) = record["setup"]["timestep"], record["setup"]["cycles"]
+        last_print = record["setup"]["print_every"] * dt
+        phases = (
+            ("psh", "preshear_start_step", "preshear_end_step"),
+            ("sh", "shear_start_step", "shear_end_step"),
+        )
+        for phase, start, end in phases:
+            steady, reason = bool(r[f"steady_{phase}"]), r[f"{phase}_reason"]
+            assert steady == reason.startswith("steady over"), (seed, phase, reason)
+            if not steady:
+                assert reason.startswith("no steady window"), (seed, phase, reason)
+                continue
+            t0, t1 = cycle[start] * dt, cycle[end] * dt
+            first, final = r[f"{phase}_t_start"], r[f"{phase}_t_end"]
+            assert t0 < first < final <= t1 and final > t1 - last_print, (seed, phase)
+            min_fraction = record["readout"]["min_fraction"]
+            assert final - first >= min_fraction * (t1 - t0) - last_print, (seed, phase)
 
 
 # ---------------------------------------------------------------------------------------------
 # pictures
 
 
-def test_pictures_are_written(runs: dict[str, Path], tmp_path: Path) -> None:
-    from demcal.virtual_tests.pictures import heap_picture, shear_cell_picture
+def test_heap_picture_draws_the_measured_slope(runs: dict[str, Path], tmp_path: Path) -> None:
+    from demcal.virtual_tests.pictures import heap_picture
 
-    heap = heap_picture(runs["aor_base"], tmp_path / "heap.png")
-    cell = shear_cell_picture(runs["shear_seed7"], tmp_path / "cell.png")
-    for png in (heap, cell):
-        data = png.read_bytes()
-        assert data[:8] == b"\x89PNG\r\n\x1a\n"
-        assert len(data) > 20_000  # a rendered scene, not an empty canvas
+    image = read_png(heap_picture(runs["aor_base"], tmp_path / "heap.png"))
+    assert image.shape == (900, 1400, 3)
+    # The cone of the readout in red, seen from the side in parallel projection: two lines that
+    # meet above the middle of their base at the angle the readout measured.
+    red = colour_mask(image, "red")
+    top, base, left, right = bbox(red)
+    apex = np.nonzero(red[top])[0].mean()
+    assert apex == pytest.approx(0.5 * (left + right), abs=0.02 * (right - left))
+    slope = np.degrees(np.arctan((base - top) / (0.5 * (right - left))))
+    assert slope == pytest.approx(_aor(runs, "aor_base")["aor"], abs=1.0)
+    # The two slice lines (orange) inside the cone, the heap filling it, nothing beside it,
+    # the colour bar on the right; the spheres are shaded by height.
+    o_top, o_bottom, o_left, o_right = bbox(colour_mask(image, "orange"))
+    assert top < o_top < o_bottom < base and left < o_left < o_right < right
+    assert ink(image)[top:base, left:right].mean() > 0.4
+    assert ink(image)[top:base, : left - 20].mean() < 0.01
+    assert ink(image)[150:750, 1200:1240].mean() > 0.5
+    assert distinct_colours(image) > 1000
+
+
+def test_shear_cell_picture_draws_lid_and_shear_plane(
+    runs: dict[str, Path], tmp_path: Path
+) -> None:
+    from demcal.virtual_tests.pictures import shear_cell_picture
+
+    case = runs["shear_seed7"]
+    image = read_png(shear_cell_picture(case, tmp_path / "cell.png"))
+    assert image.shape == (900, 1400, 3)
+    record = json.loads((case / "case.json").read_text())
+    setup = record["setup"]
+    table = read_print_file(case / record["files"]["table"], columns=["step", "lid_z"])
+    lid_z = float(table[table["step"] <= setup["snapshot_step"]]["lid_z"].iloc[-1])
+    # The lid edge-on (dark red, 2 R wide) and the shear plane (black, 2.6 R wide) below it,
+    # at the distance lid_z - z_shear on the same scale.
+    lid = colour_mask(image, "darkred")
+    l_top, l_bottom, l_left, l_right = bbox(lid)
+    assert l_bottom - l_top < 10
+    scale = (l_right - l_left) / (2.0 * setup["radius"])  # pixels per metre
+    black = colour_mask(image, "black", tol=0.1)
+    rows = np.flatnonzero(black.sum(axis=1) > 1.2 * (l_right - l_left))
+    assert rows.size and np.ptp(rows) < 10
+    line = black[rows[0]]
+    width = np.ptp(np.flatnonzero(line))
+    assert width / scale == pytest.approx(2.6 * setup["radius"], rel=0.03)
+    drop = (rows.mean() - 0.5 * (l_top + l_bottom)) / scale
+    assert drop == pytest.approx(lid_z - setup["z_shear"], rel=0.03)
+    # The sample between floor and lid, its particles coloured by speed.
+    assert ink(image)[l_bottom + 5 : int(rows[0]), l_left:l_right].mean() > 0.5
+    assert distinct_colours(image) > 1000
 
 
 # ---------------------------------------------------------------------------------------------
@@ -209,15 +279,16 @@ def test_cycles_in_one_deck_versus_separate_runs(runs: dict[str, Path]) -> None:
     for key in ("mu_psh", "mu_sh", "rho_b"):
         assert first[key] == pytest.approx(separate[0.4][key], rel=1e-12)
     # Later cycles carry the shear history of the earlier ones: the bed compacts from cycle to
-    # cycle and resists the shear phase more than a fresh sample does, beyond the
-    # seed-to-seed scatter of fresh runs. This is why the workflow runs each load condition
-    # separately (shear_cell.separate_runs).
+    # cycle, denser than a fresh sample beyond the seed-to-seed scatter of fresh runs. This is
+    # why the workflow runs each load condition separately (shear_cell.separate_runs).
     fresh = [_shear(runs, f"shear_seed{s}") for s in SEEDS]
     rho_scatter = np.std([r["rho_b"] for r in fresh], ddof=1)
     later = [(cycles.iloc[k], separate[p]) for k, p in ((1, 0.6), (2, 0.8), (3, 1.0))]
     denser = [c["rho_b"] - f["rho_b"] for c, f in later]
     assert all(d > 0 for d in denser)
     assert np.mean(denser) > 2.5 * rho_scatter
+    # The steady stress ratio is a critical-state value: the compaction of the earlier cycles
+    # does not carry over into it beyond the seed-to-seed scatter of fresh runs.
     mu_sh_scatter = np.std([r["mu_sh"] for r in fresh], ddof=1)
-    stronger = [c["mu_sh"] - f["mu_sh"] for c, f in later]
-    assert np.mean(stronger) > mu_sh_scatter
+    history = [c["mu_sh"] - f["mu_sh"] for c, f in later]
+    assert abs(np.mean(history)) < 2.0 * mu_sh_scatter, (history, mu_sh_scatter)

@@ -5,14 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from demcal.core.experiments import MeasuredCondition
 from demcal.identification.acceptance import (
-    MeasuredCondition,
-    marked_then_valid,
     relative_deviation,
     sequential_filter,
-    within_all_conditions,
     within_tolerance,
 )
+from demcal.identification.screening import screen
 
 
 def test_relative_deviation_values() -> None:
@@ -83,16 +82,40 @@ def test_measured_condition_label_load_and_validation() -> None:
         MeasuredCondition({"aor": 38.85}, uncertainties={"rho_b": 42.0})
 
 
+class Lookup:
+    """Predictions read from a table: candidate ``k`` (first input), at the load ``normal_stress``
+    (second input, when given); records the candidates it was asked about."""
+
+    def __init__(self, by_load: dict[float | None, np.ndarray]) -> None:
+        self.by_load = by_load
+        self.calls: list[np.ndarray] = []
+
+    def predict(self, X: np.ndarray) -> np.ndarray:
+        k = X[:, 0].astype(int)
+        self.calls.append(k.copy())
+        if X.shape[1] == 1:
+            return self.by_load[None][k]
+        return np.array([self.by_load[float(s)][i] for i, s in zip(k, X[:, 1], strict=True)])
+
+
+def candidates(n: int) -> dict[str, np.ndarray]:
+    """A one-axis grid whose values are the candidate numbers 0 .. n-1."""
+    return {"k": np.arange(n, dtype=np.float64)}
+
+
 def test_several_conditions_are_anded() -> None:
+    # The screening of the pipeline, two shear-cell load conditions: a set must match both.
     low = MeasuredCondition({"mu_psh": 0.70}, normal_stress=1068.0, P=1.0)
     high = MeasuredCondition({"mu_psh": 0.60}, normal_stress=10070.0, P=1.0)
-    pred_low = {"mu_psh": np.array([0.70, 0.70, 0.60, 0.60])}
-    pred_high = {"mu_psh": np.array([0.60, 0.70, 0.60, 0.70])}
-    np.testing.assert_array_equal(
-        within_all_conditions([pred_low, pred_high], [low, high]), [True, False, False, False]
+    mu_psh = Lookup(
+        {1068.0: np.array([0.70, 0.70, 0.60, 0.60]), 10070.0: np.array([0.60, 0.70, 0.60, 0.70])}
     )
-    with pytest.raises(ValueError, match="2 conditions"):
-        within_all_conditions([pred_low], [low, high])
+    result = screen(
+        {"mu_psh": (mu_psh, ["k", "normal_stress"])}, candidates(4), {"P": 1.0}, [low, high]
+    )
+    np.testing.assert_array_equal(result.indices, [0])
+    assert result.stage_counts == {low.label: 2, high.label: 1}
+    assert result.predictions[high.label]["mu_psh"].tolist() == [0.60]
 
 
 def test_sequential_filter_passes_only_survivors_on() -> None:
@@ -117,38 +140,38 @@ def test_sequential_filter_rejects_bad_mask() -> None:
         sequential_filter(np.arange(3), [lambda ids: ids.astype(float)])
 
 
-def test_marked_then_valid_evaluates_repose_only_on_marked_sets() -> None:
+def test_repose_is_evaluated_only_on_marked_sets() -> None:
+    # Eq. 3 marks sets on the shear cell, eq. 4 checks only those on the angle of repose.
     shear = MeasuredCondition(
         {"mu_psh": 0.6, "mu_sh": 0.5, "rho_b": 1760.0}, normal_stress=10070.0, P=1.0
     )
     repose = MeasuredCondition({"aor": 38.85})
-    pred = {
+    shear_values = {
         "mu_psh": np.array([0.60, 0.61, 0.80, 0.59, 0.60]),
         "mu_sh": np.array([0.50, 0.49, 0.50, 0.51, 0.50]),
         "rho_b": np.array([1760.0, 1800.0, 1760.0, 1700.0, 2000.0]),
     }
-    aor_all = np.array([38.0, 45.0, 38.85, 39.5, 38.85])
-    calls: list[np.ndarray] = []
+    predictors = {
+        name: (Lookup({10070.0: values}), ["k", "normal_stress"])
+        for name, values in shear_values.items()
+    }
+    aor = Lookup({None: np.array([38.0, 45.0, 38.85, 39.5, 38.85])})
+    predictors["aor"] = (aor, ["k"])
+    result = screen(predictors, candidates(5), {"P": 1.0}, [shear, repose], tol=0.05)
+    assert result.stage_counts == {shear.label: 3, repose.label: 2}
+    np.testing.assert_array_equal(result.indices, [0, 3])
+    assert len(aor.calls) == 1
+    np.testing.assert_array_equal(aor.calls[0], [0, 1, 3])
+    np.testing.assert_allclose(result.predictions[repose.label]["aor"], [38.0, 39.5])
 
-    def predict_repose(rows: np.ndarray) -> dict[str, np.ndarray]:
-        calls.append(rows.copy())
-        return {"aor": aor_all[rows]}
 
-    result = marked_then_valid([pred], [shear], predict_repose, repose, tol=0.05)
-    np.testing.assert_array_equal(result.marked, [True, True, False, True, False])
-    np.testing.assert_array_equal(result.valid, [True, False, False, True, False])
-    assert len(calls) == 1
-    np.testing.assert_array_equal(calls[0], [0, 1, 3])
-
-
-def test_marked_then_valid_skips_repose_when_nothing_marked() -> None:
+def test_repose_is_not_evaluated_when_nothing_is_marked() -> None:
     shear = MeasuredCondition({"rho_b": 1760.0}, normal_stress=10070.0, P=1.0)
-
-    def never(rows: np.ndarray) -> dict[str, np.ndarray]:
-        raise AssertionError("repose predictor called without marked sets")
-
-    result = marked_then_valid(
-        [{"rho_b": np.array([1000.0, 3000.0])}], [shear], never, MeasuredCondition({"aor": 38.0})
-    )
-    assert not result.marked.any()
-    assert not result.valid.any()
+    rho_b = Lookup({10070.0: np.array([1000.0, 3000.0])})
+    aor = Lookup({None: np.array([38.0, 38.0])})
+    predictors = {"rho_b": (rho_b, ["k", "normal_stress"]), "aor": (aor, ["k"])}
+    stages = [shear, MeasuredCondition({"aor": 38.0})]
+    result = screen(predictors, candidates(2), {"P": 1.0}, stages)
+    assert result.n_accepted == 0 and result.n_total == 2
+    assert result.stage_counts == {shear.label: 0, "aor": 0}
+    assert aor.calls == []

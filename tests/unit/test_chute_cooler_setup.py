@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from demcal.application.chute_cooler.contact_parameters import application_parameters
 from demcal.application.chute_cooler.deck import (
     DECK_NAME,
     IdentifiedParametersError,
@@ -14,19 +15,20 @@ from demcal.application.chute_cooler.deck import (
     read_identified_parameters,
     render_chute_cooler,
 )
-from demcal.application.chute_cooler.setup import (
-    ChuteCoolerSetup,
-    application_parameters,
+from demcal.application.chute_cooler.layout import ChuteCoolerSetup
+from demcal.application.chute_cooler.meshes import (
     box_row_triangles,
-    chute_cooler_setup,
     chute_triangles,
     hole_grid,
     perforated_plate,
-    stream_estimate,
 )
+from demcal.application.chute_cooler.setup import chute_cooler_setup, stream_estimate
 from demcal.core.config import load_config, validate_config
-from demcal.decks.stl_mesh import read_stl, surface_area, triangle_areas, triangle_normals
-from demcal.virtual_tests.shear_cell.setup import GRAVITY, SetupError, material_setup
+from demcal.core.config_values import SetupError
+from demcal.core.parameters import GRAVITY
+from demcal.decks.stl_file import read_stl
+from demcal.decks.triangle_surface import surface_area, triangle_areas, triangle_normals
+from demcal.particles.material import material_setup
 
 ROOT = Path(__file__).resolve().parents[2]
 PARAMS = {
@@ -298,10 +300,7 @@ def test_render_refuses_before_writing(tmp_path):
 
 @pytest.mark.parametrize("name", ["tiny.yaml", "config.yaml", "paper.yaml"])
 def test_shipped_configurations_give_a_workable_case(name):
-    path = ROOT / "config" / name
-    if not path.exists():
-        pytest.skip(f"{name} not present")
-    cfg = load_config(path)
+    cfg = load_config(ROOT / "config" / name)
     section = dict(cfg["application"])
     if section["parameters"] is None:
         section["parameters"] = dict(PARAMS)

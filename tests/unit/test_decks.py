@@ -15,8 +15,10 @@ import pytest
 from demcal.bulk.values import MissingOutputError, extract
 from demcal.core.config import load_config, validate_config
 from demcal.decks.case_validation import CaseValidationError, MissingColumnError
-from demcal.decks.render import format_number, render_case, template_environment
-from demcal.decks.stl_mesh import read_stl, surface_area
+from demcal.decks.render import format_number, template_environment
+from demcal.decks.stl_file import read_stl
+from demcal.decks.triangle_surface import surface_area
+from demcal.virtual_tests.deck import render_case
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -196,8 +198,22 @@ def test_meshes_have_the_cell_geometry(tmp_path: Path) -> None:
 def test_case_json_holds_the_readout_inputs(tmp_path: Path) -> None:
     render_case("shear_cell", CASE, tiny(), tmp_path)
     record = json.loads((tmp_path / "case.json").read_text())
-    assert record["readout"]["radius"] == record["setup"]["radius"]
-    assert record["readout"]["z_shear"] == record["setup"]["z_shear"]
+    readout, cell = record["readout"], tiny()["shear_cell"]
+    # Cell radius R = dCylDp * r_particle = 10 * 1.5 mm; shear plane at 0.5 * 1.5 R.
+    radius = cell["dCylDp"] * tiny()["particles"]["radius"]
+    assert radius == pytest.approx(0.015)
+    assert readout["radius"] == pytest.approx(radius, rel=1e-12)
+    assert readout["z_shear"] == pytest.approx(
+        cell["shear_plane"] * cell["fill_height"] * radius, rel=1e-12
+    )
+    assert (readout["z_floor"], readout["gravity"]) == (0.0, 9.81)
+    assert readout["min_fraction"] == cell["plateau_min_fraction"]
+    # The stress the readout divides by is that of the lid the engine moves: its corners lie
+    # on the readout radius, and the lower ring ends at the readout's shear plane.
+    lid = read_stl(tmp_path / "meshes" / "shear_lid.stl").triangles
+    assert np.hypot(lid[..., 0], lid[..., 1]).max() == pytest.approx(readout["radius"])
+    lower = read_stl(tmp_path / "meshes" / "shear_lower.stl").triangles
+    assert lower[..., 2].max() == pytest.approx(readout["z_shear"])
     assert record["case"]["case_id"] == "c0007"
     assert record["files"]["table"] == "shear_cell.txt"
 
@@ -261,12 +277,23 @@ def test_unknown_test_is_rejected(tmp_path: Path) -> None:
 @pytest.mark.parametrize("name", ["tiny.yaml", "config.yaml", "paper.yaml"])
 def test_profiles_are_valid_and_render(tmp_path: Path, name: str) -> None:
     cfg = load_config(ROOT / "config" / name)
-    for section in ("particles", "material", "shear_cell", "angle_of_repose"):
-        assert section in cfg
     dCylDp = max(cfg["shear_cell"]["min_dCylDp"], cfg["shear_cell"]["dCylDp"])
     case = {**CASE, "dCylDp": dCylDp, "normal_stress": cfg["shear_cell"]["normal_stresses"][0]}
     record = render_case("shear_cell", {**case, "P": cfg["shear_cell"]["P"][0]}, cfg, tmp_path)
-    assert record["setup"]["timestep"] > 0
+    # The case follows the profile: its size classes, R = dCylDp * r_ref, and the time step
+    # given, or else the Rayleigh fraction of the smallest particle's Rayleigh time.
+    particles, setup = record["particles"], record["setup"]
+    classes = 1 if cfg["particles"]["distribution"] == "monodisperse" else None
+    assert len(particles["radii"]) == (classes or cfg["particles"]["classes"])
+    assert setup["radius"] == pytest.approx(dCylDp * particles["mass_mean_radius"], rel=1e-12)
+    fixed, fraction = cfg["material"]["timestep"], cfg["material"]["rayleigh_fraction"]
+    rayleigh = fraction * record["material"]["rayleigh_time"]
+    if fixed > 0:
+        assert setup["timestep"] == fixed < rayleigh
+    else:
+        assert 0.99 * rayleigh < setup["timestep"] <= rayleigh
+    deck = (tmp_path / "in.shear_cell").read_text()
+    assert f"timestep {format_number(setup['timestep'])}\n" in deck
 
 
 def test_paper_profile_has_table_1_values() -> None:

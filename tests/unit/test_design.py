@@ -1,4 +1,5 @@
-"""Tests of demcal.design.table: factorial and sampled designs, load conditions, table files."""
+"""Tests of demcal.design.build and demcal.design.table: factorial and sampled designs, load
+conditions, table files."""
 
 from __future__ import annotations
 
@@ -10,20 +11,26 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.design.table import (
-    PAPER_TABLE2_LEVELS,
-    DesignSpecError,
-    DesignTableError,
+from demcal.core.config import load_config
+from demcal.design.build import (
     build_design,
-    case_ids,
-    expand_load_conditions,
     factorial_design,
     latin_hypercube_design,
     random_design,
-    read_design_table,
     sobol_design,
+)
+from demcal.design.table import (
+    DesignSpecError,
+    DesignTableError,
+    case_ids,
+    expand_load_conditions,
+    read_design_table,
     write_design_table,
 )
+
+ROOT = Path(__file__).resolve().parents[2]
+# The levels of the paper's Table 2, as the paper profile gives them to the workflow.
+PAPER_TABLE2_LEVELS = load_config(ROOT / "config" / "paper.yaml")["design"]["levels"]
 
 RANGES = {
     "coefficientFriction": (0.1, 1.0),

@@ -6,18 +6,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.core.experiments import Experiment
-from demcal.discrepancy.find import (
-    ParameterBox,
-    SurrogateModel,
-    describe_disagreement,
-    find,
-    format_stress,
-    minimise_chi2,
-    observation_table,
-    pinned_parameters,
-)
-from demcal.identification.acceptance import MeasuredCondition
+from demcal.core.experiments import Experiment, MeasuredCondition
+from demcal.discrepancy.best_fit import ParameterBox, minimise_chi2, pinned_parameters
+from demcal.discrepancy.find import describe_disagreement, find
+from demcal.discrepancy.observations import SurrogateModel, format_stress, observation_table
 
 FEATURES = ["coefficientFriction", "density", "normal_stress", "P"]
 STRESSES = (1068.0, 2029.0, 10070.0)

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from demcal.core.config import load_config
-from demcal.core.experiments import Experiment
+from demcal.core.experiments import Experiment, MeasuredCondition
 from demcal.discrepancy.candidates import (
     applicability,
     base_point,
@@ -20,7 +20,6 @@ from demcal.discrepancy.candidates import (
 )
 from demcal.discrepancy.plan import DiscrepancyPlan
 from demcal.discrepancy.synthetic import study_config
-from demcal.identification.acceptance import MeasuredCondition
 
 ROOT = Path(__file__).resolve().parents[2]
 

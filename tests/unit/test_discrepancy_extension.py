@@ -10,14 +10,14 @@ import pytest
 from demcal.discrepancy.candidates import Candidate
 from demcal.discrepancy.extension import (
     extended_training_data,
-    read_runs,
     rmse_of,
     train_extended_surrogate,
 )
 from demcal.discrepancy.report import gap_figure, gap_of, gap_table, markdown_table
+from demcal.discrepancy.run_results import read_runs, run_values
 from demcal.discrepancy.synthetic import replicate_record
-from demcal.discrepancy.workflow import run_values
 from demcal.surrogates.training import load_surrogate
+from tests.figures import read_png, saved_figures
 
 COHESION = Candidate(
     "cohesion", "d", {}, "cohesionEnergyDensity", None, 0.0, (0.0, 5e4), (4e4,), False
@@ -158,9 +158,31 @@ def test_gap_table_and_figure(tmp_path):
     assert table["z_dem_before"].to_numpy() == pytest.approx([-2.5, -5.0])
     assert table["z_dem_after"].to_numpy() == pytest.approx([0.2, 1.0])
     assert gap_of(table["z_before"]) == pytest.approx(math.sqrt(10.0))
-    assert gap_of([math.nan]) != gap_of([math.nan])  # NaN when nothing is finite
-    gap_figure(table, "test", tmp_path / "gap.png")
-    assert (tmp_path / "gap.png").stat().st_size > 10_000
+    assert math.isnan(gap_of([math.nan]))  # nothing is finite
+    with saved_figures() as figures:
+        gap_figure(table, "test", tmp_path / "gap.png")
+    ((surrogate, dem),) = [f.axes for f in figures]
+    assert figures[0].get_suptitle() == "test"
+    # |z| bars, before (left of each tick) and after (right), on the common sigma: 0.1 for
+    # mu_psh, the after model's 12 kg/m^3 for rho_b; the DEM panel on the current sigma.
+    expected = {
+        surrogate: ([2.0, 40.0 / 12.0], [0.2, 5.0 / 12.0], "z_before_common", "z_after_common"),
+        dem: ([2.5, 5.0], [0.2, 1.0], "z_dem_before", "z_dem_after"),
+    }
+    for ax, (before_z, after_z, before_col, after_col) in expected.items():
+        bars = ax.patches
+        assert [b.get_x() + 0.5 * b.get_width() for b in bars] == pytest.approx(
+            [-0.2, 0.8, 0.2, 1.2]
+        )
+        assert [b.get_height() for b in bars] == pytest.approx([*before_z, *after_z])
+        legend = [t.get_text() for t in ax.get_legend().get_texts()]
+        assert legend == [
+            f"before (gap {gap_of(table[before_col]):.2f})",
+            f"after (gap {gap_of(table[after_col]):.2f})",
+        ]
+    labels = [t.get_text() for t in dem.get_xticklabels()]
+    assert labels == ["mu_psh\n1068 Pa, P=1", "rho_b\n1068 Pa, P=1"]
+    assert read_png(tmp_path / "gap.png").shape == (780, 720, 3)  # 6 x 6.5 in at 120 dpi
     text = markdown_table(table[["observable", "z_before"]])
     assert text.splitlines()[2] == "| mu_psh | -2 |"
 

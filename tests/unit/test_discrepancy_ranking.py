@@ -5,17 +5,12 @@ import math
 import numpy as np
 import pytest
 
-from demcal.core.experiments import Experiment
-from demcal.discrepancy.find import ParameterBox, SurrogateModel, find, observation_table
-from demcal.discrepancy.ranking import (
-    EffectResponse,
-    fit_candidate,
-    null_fit,
-    rank_candidates,
-    ranking_sigma,
-    response_signature,
-)
-from demcal.identification.acceptance import MeasuredCondition
+from demcal.core.experiments import Experiment, MeasuredCondition
+from demcal.discrepancy.best_fit import ParameterBox
+from demcal.discrepancy.effect_response import EffectResponse, response_signature
+from demcal.discrepancy.find import find
+from demcal.discrepancy.observations import SurrogateModel, observation_table
+from demcal.discrepancy.ranking import fit_candidate, null_fit, rank_candidates, ranking_sigma
 
 FEATURES = ["coefficientFriction", "density", "normal_stress", "P"]
 STRESSES = (1068.0, 2029.0, 10070.0)

@@ -9,17 +9,15 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.engine_io.output import (
+from demcal.engine_io.dump_file import read_dump, read_dump_last
+from demcal.engine_io.fix_output import read_ave_time, read_print_file
+from demcal.engine_io.log_file import read_log
+from demcal.engine_io.output_errors import (
     EngineOutputError,
     MissingColumnError,
     TruncatedOutputWarning,
-    read_ave_time,
-    read_dump,
-    read_dump_last,
-    read_log,
-    read_print_file,
-    read_vtk_particles,
 )
+from demcal.engine_io.vtk_file import read_vtk_particles
 
 PRINT_COLUMNS = [
     "step",

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib.image as mpimg
 import numpy as np
 import pandas as pd
 import pytest
@@ -21,6 +20,7 @@ from demcal.identification.statistics import (
     write_table5_csv,
     write_table5_markdown,
 )
+from tests.figures import colour_mask, read_png, saved_figures
 
 RANGES = {
     "coefficientFriction": (0.1, 1.0),
@@ -177,14 +177,7 @@ def test_dominant_bin_map_tie_and_axis_arrays() -> None:
         dominant_bin_map(valid, {k: v for k, v in axes.items() if k != "coefficientRestitution"})
 
 
-def _assert_png(path: Path) -> np.ndarray:
-    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    image = mpimg.imread(path)
-    assert image.shape[0] > 100 and image.shape[1] > 100
-    return image
-
-
-def test_box_plot_written(tmp_path: Path) -> None:
+def test_box_plot_shows_each_parameter_over_its_maximum(tmp_path: Path) -> None:
     rng = np.random.default_rng(0)
     valid = pd.DataFrame(
         {
@@ -194,16 +187,37 @@ def test_box_plot_written(tmp_path: Path) -> None:
             "density": rng.uniform(2200.0, 2400.0, 200),
         }
     )
-    out = box_plot_normalised(valid, tmp_path / "fig6.png", "SSC, 10070 Pa, P = 1")
-    image = _assert_png(out)
-    assert image[..., :3].std() > 0.05  # not a blank canvas
+    with saved_figures() as figures:
+        out = box_plot_normalised(valid, tmp_path / "fig6.png", "SSC, 10070 Pa, P = 1")
+    ((ax,),) = [f.axes for f in figures]
+    labels = [t.get_text() for t in ax.get_xticklabels()]
+    assert labels == ["mu_s (-)", "mu_r (-)", "COR (-)", "rho_p (kg/m^3)"]
+    assert ax.get_title() == "SSC, 10070 Pa, P = 1 (200 valid sets)"
+    # One box per parameter at x = 1..4: quartiles and median of the column over its maximum.
+    boxes = [line for line in ax.lines if len(line.get_xdata()) == 5]
+    medians = [
+        line
+        for line in ax.lines
+        if len(line.get_xdata()) == 2 and np.ptp(line.get_xdata()) > 0.4
+    ]
+    assert len(boxes) == len(medians) == 4
+    for k, name in enumerate(valid.columns):
+        scaled = valid[name] / valid[name].max()
+        box, median = boxes[k], medians[k]
+        assert np.mean([min(box.get_xdata()), max(box.get_xdata())]) == pytest.approx(k + 1)
+        q1, q3 = np.percentile(scaled, [25, 75])
+        assert (min(box.get_ydata()), max(box.get_ydata())) == pytest.approx((q1, q3))
+        assert median.get_ydata()[0] == pytest.approx(np.median(scaled))
+    # Every value is at most its maximum: nothing is drawn above 1.
+    assert max(max(line.get_ydata(), default=0.0) for line in ax.lines) == pytest.approx(1.0)
+    assert read_png(out).shape == (480, 660, 3)  # 5.5 x 4 in at 120 dpi
     with pytest.raises(ValueError, match="no valid sets"):
         box_plot_normalised(valid.iloc[:0], tmp_path / "empty.png", "empty")
     with pytest.raises(KeyError, match="porosity"):
         box_plot_normalised(valid, tmp_path / "x.png", "x", parameters=["porosity"])
 
 
-def test_cor_density_plot_written(tmp_path: Path) -> None:
+def test_cor_density_plot_colours_each_cell_by_its_dominant_cor_range(tmp_path: Path) -> None:
     rng = np.random.default_rng(1)
     n = 500
     mu_s = rng.uniform(0.1, 1.0, n)
@@ -215,9 +229,21 @@ def test_cor_density_plot_written(tmp_path: Path) -> None:
         }
     )
     axes = {k: v for k, v in RANGES.items() if k != "density"}
-    out = cor_density_plot(valid, axes, tmp_path / "fig7.png", n_cells=15)
-    image = _assert_png(out)
-    # A band of coloured cells on a white field: both white and non-grey pixels exist.
-    rgb = image[..., :3]
-    assert (rgb.min(axis=2) > 0.99).mean() > 0.2
-    assert (rgb.max(axis=2) - rgb.min(axis=2) > 0.3).mean() > 0.01
+    with saved_figures() as figures:
+        out = cor_density_plot(valid, axes, tmp_path / "fig7.png", n_cells=15)
+    ((ax,),) = [f.axes for f in figures]
+    expected = dominant_bin_map(valid, axes, n_cells=15, n_bins=4).dominant
+    (mesh,) = ax.collections
+    shown = np.ma.asarray(mesh.get_array()).reshape(expected.shape)
+    np.testing.assert_array_equal(shown.mask, expected < 0)
+    np.testing.assert_array_equal(shown.filled(-1), expected)
+    # A band along mu_r = 1.1 - mu_s: COR rises with mu_s, so all four ranges show.
+    assert set(np.unique(expected)) == {-1, 0, 1, 2, 3}
+    assert (ax.get_xlim(), ax.get_ylim()) == ((0.1, 1.0), (0.1, 1.0))
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend == ["COR 0.50-0.60", "COR 0.60-0.70", "COR 0.70-0.80", "COR 0.80-0.90"]
+    image = read_png(out)
+    assert image.shape == (576, 660, 3)  # 5.5 x 4.8 in at 120 dpi
+    # The empty cells stay white: a band of coloured cells on a white field.
+    assert colour_mask(image, "white").mean() > 0.2
+    assert (image.max(axis=2) - image.min(axis=2) > 0.3).mean() > 0.01

@@ -2,6 +2,7 @@
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -11,13 +12,15 @@ import yaml
 
 from demcal.bulk.dataset import case_rows, collect, usable
 from demcal.core.config import ConfigError, validate_config
-from demcal.core.experiments import Experiment, load_experiment
+from demcal.core.experiments import Experiment, MeasuredCondition, load_experiment
 from demcal.design.cases import case_ids, case_row, design_from_config, verification_case
 from demcal.engine_io.run import engine_command, run_deck
-from demcal.identification.acceptance import MeasuredCondition
 from demcal.identification.calibration import ConstantInputs, calibrate
 from demcal.identification.verification import verification_table
+from demcal.identification.verification_run import write_verification_table
 from tests.engine.conftest import engine_path
+
+ROOT_DIR = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture
@@ -64,6 +67,7 @@ def test_engine_command_template():
         engine_command("dem_engine -in {input}", "in.x", 1)
 
 
+@pytest.mark.engine
 def test_run_deck_records_success_and_failure(tmp_path):
     template = f"{engine_path()} -in {{deck}} -noprogress"
     (tmp_path / "ok.in").write_text('print "hello"\n')
@@ -216,6 +220,11 @@ def test_calibration_recovers_truth_with_analytic_surrogates():
         if name == "coefficientRestitution":
             continue  # no network depends on it: the whole axis stays valid
         assert both[name].min() <= value <= both[name].max()
+        # The measurements pin the parameter to a quarter of its box (by hand: mu_s within
+        # 0.16, mu_r 0.14, density 200 kg/m^3 of widths 0.9, 0.9, 1000).
+        low, high, _ = screening["axes"][name]
+        assert both[name].max() - both[name].min() < 0.25 * (high - low), name
+    assert set(both["coefficientRestitution"]) == set(result.axes["coefficientRestitution"])
     assert result.identified_group == "SSC & AoR"
     assert result.identified["density"]["mean"] == pytest.approx(3000.0, rel=0.05)
 
@@ -257,11 +266,126 @@ def test_verification_table():
         [
             MeasuredCondition(
                 values={"rho_b": 1760.0}, uncertainties={"rho_b": 42.0}, normal_stress=2029.0, P=1.0
-            )
+            ),
+            # No verification run at this load: no DEM value, never within the tolerance.
+            MeasuredCondition(values={"mu_psh": 0.6}, normal_stress=1068.0, P=1.0),
         ],
         angle_of_repose=38.85,
     )
-    table = verification_table(runs, exp, 0.05)
-    assert list(table["observable"]) == ["rho_b", "aor"]
-    assert table["relative_deviation"].iloc[0] == pytest.approx(40 / 1760)
-    assert list(table["within_tolerance"]) == [True, False]
+    table = verification_table({"configured": runs}, exp, 0.05)
+    assert list(table["observable"]) == ["rho_b", "mu_psh", "aor"]
+    assert table["deviation_configured"].iloc[0] == pytest.approx(40 / 1760)
+    assert math.isnan(table["dem_configured"].iloc[1])
+    assert math.isnan(table["deviation_configured"].iloc[1])
+    assert table["deviation_configured"].iloc[2] == pytest.approx(1 - 36.0 / 38.85)
+    assert list(table["within_tolerance_configured"]) == [True, False, False]
+    assert "engine_difference" not in table  # one engine: nothing to compare
+
+
+def test_verification_table_two_engines_side_by_side(tmp_path):
+    """The identified set on the bundled engine and on LIGGGHTS, each against the measurement
+    and against each other (values of a tiny-profile run)."""
+
+    def runs(mu_psh: float, rho_b: float, aor: float) -> pd.DataFrame:
+        return pd.DataFrame(
+            {
+                "test": ["shear_cell", "shear_cell", "angle_of_repose"],
+                "normal_stress": [2029.0, 2029.0, math.nan],
+                "P": [0.5, 1.0, math.nan],
+                "mu_psh": [mu_psh, mu_psh, math.nan],
+                "rho_b": [rho_b, rho_b, math.nan],
+                "aor": [math.nan, math.nan, aor],
+            }
+        )
+
+    bundled, liggghts = runs(2.20, 1540.0, 27.5), runs(2.42, 1496.0, 30.1)
+    exp = Experiment(
+        "m",
+        "",
+        [MeasuredCondition(values={"mu_psh": 2.27, "rho_b": 1526.5}, normal_stress=2029.0, P=1.0)],
+        angle_of_repose=28.04,
+        angle_of_repose_sd=0.28,
+    )
+    table = verification_table({"bundled": bundled, "liggghts": liggghts}, exp, 0.05)
+    assert list(table.columns) == [
+        "observable",
+        "normal_stress",
+        "P",
+        "measured",
+        "measured_sd",
+        "dem_bundled",
+        "deviation_bundled",
+        "within_tolerance_bundled",
+        "dem_liggghts",
+        "deviation_liggghts",
+        "within_tolerance_liggghts",
+        "engine_difference",
+    ]
+    rows = table.set_index("observable")
+    assert list(rows.index) == ["mu_psh", "rho_b", "aor"]
+    assert list(rows["dem_bundled"]) == [2.20, 1540.0, 27.5]
+    assert list(rows["dem_liggghts"]) == [2.42, 1496.0, 30.1]
+    np.testing.assert_allclose(
+        rows["deviation_bundled"], [1 - 2.20 / 2.27, 1540.0 / 1526.5 - 1, 1 - 27.5 / 28.04]
+    )
+    np.testing.assert_allclose(
+        rows["deviation_liggghts"], [2.42 / 2.27 - 1, 1 - 1496.0 / 1526.5, 30.1 / 28.04 - 1]
+    )
+    # mu_psh: bundled 3.1 % off, LIGGGHTS 6.6 % off (outside 5 %); AoR: LIGGGHTS 7.3 % off.
+    assert list(rows["within_tolerance_bundled"]) == [True, True, True]
+    assert list(rows["within_tolerance_liggghts"]) == [False, True, False]
+    np.testing.assert_allclose(
+        rows["engine_difference"], [2.42 / 2.20 - 1, 1 - 1496.0 / 1540.0, 30.1 / 27.5 - 1]
+    )
+    assert rows.loc["aor", "measured_sd"] == 0.28
+    # A run missing on one engine: its value and the engine difference are NaN.
+    table = verification_table(
+        {"bundled": bundled, "liggghts": liggghts.iloc[:2]}, exp, 0.05
+    ).set_index("observable")
+    assert math.isnan(table.loc["aor", "dem_liggghts"])
+    assert math.isnan(table.loc["aor", "engine_difference"])
+    assert not table.loc["aor", "within_tolerance_liggghts"]
+    assert table.loc["aor", "within_tolerance_bundled"]
+
+
+def test_write_verification_table_lists_engines_and_failed_runs(tmp_path):
+    """Two engines' bulk files against the tiny synthetic measurement; a failed run is named."""
+    experiment = ROOT_DIR / "config" / "experiments" / "synthetic_reference_tiny.yaml"
+    base = {"normal_stress": 2029.0, "P": 1.0, "case_id": "identified_s1"}
+    files = {}
+    for engine, shear, aor, status in (
+        ("liggghts", (1.97, 2.31, 1404.4), 30.0, "ok"),
+        ("bundled", (math.nan, math.nan, math.nan), 28.06, "failed"),
+    ):
+        rows = pd.DataFrame(
+            [
+                {
+                    **base,
+                    "test": "shear_cell",
+                    **dict(zip(("mu_psh", "mu_sh", "rho_b"), shear, strict=True)),
+                    "status": status,
+                    "error": "ERROR: unstable" if status != "ok" else "",
+                },
+                {"test": "angle_of_repose", "case_id": "identified", "aor": aor, "status": "ok"},
+            ]
+        )
+        files[engine] = [tmp_path / f"{engine}.csv"]
+        rows.to_csv(files[engine][0], index=False)
+    table = write_verification_table(
+        files,
+        experiment,
+        0.05,
+        tmp_path / "v.csv",
+        tmp_path / "v.md",
+        commands={"liggghts": "liggghts -in {deck}", "bundled": "dem_engine -in {deck}"},
+        threads=2,
+    )
+    rows = table.set_index("observable")
+    assert rows.loc["aor", "dem_liggghts"] == 30.0 and rows.loc["aor", "dem_bundled"] == 28.06
+    assert rows.loc["aor", "engine_difference"] == pytest.approx(1 - 28.06 / 30.0)
+    assert rows.loc["rho_b", "deviation_liggghts"] == pytest.approx(1 - 1404.4 / 1526.531301)
+    assert math.isnan(rows.loc["mu_psh", "dem_bundled"])
+    text = (tmp_path / "v.md").read_text()
+    assert "- liggghts: `liggghts -in {deck}`, 2 thread(s)" in text
+    assert "FAILED on bundled: shear_cell identified_s1 (ERROR: unstable)" in text
+    assert pd.read_csv(tmp_path / "v.csv").shape == table.shape

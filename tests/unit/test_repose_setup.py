@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import pytest
 
 from demcal.core.config import validate_config
+from demcal.core.config_values import SetupError
+from demcal.particles.material import material_setup
+from demcal.particles.run_setup import RunSetup
+from demcal.particles.size_distribution import size_distribution
 from demcal.virtual_tests.angle_of_repose.setup import lift_froude_number, repose_setup
-from demcal.virtual_tests.shear_cell.setup import SetupError, material_setup, size_distribution
 
 CASE = {
     "case_id": "c0002",
@@ -81,7 +85,10 @@ def test_insertion_inside_tube_and_below_its_top() -> None:
 def test_readout_settings_are_passed_on() -> None:
     s, _ = setup_for(n_slices=16, n_sectors=6, min_contacts=3)
     assert (s.n_slices, s.n_sectors, s.min_contacts) == (16, 6, 3)
-    assert s.as_dict()["box_lo"] == list(s.box_lo)
+    record = json.loads(json.dumps(s.as_dict()))  # as case.json holds them
+    assert (record["n_slices"], record["n_sectors"], record["min_contacts"]) == (16, 6, 3)
+    assert record["radius"] == pytest.approx(10 * 1e-3)
+    assert record["box_lo"][2] < 0.0 < record["tube_height"] < record["box_hi"][2]
 
 
 @pytest.mark.parametrize(
@@ -101,3 +108,13 @@ def test_bad_settings_name_the_key(aor: dict, key: str) -> None:
 def test_too_small_tube_is_rejected() -> None:
     with pytest.raises(SetupError, match="dCylDp"):
         setup_for(dCylDp=2.5)
+
+
+def test_run_fields_and_seeds_are_those_of_the_shared_run_setup() -> None:
+    s, dist = setup_for()
+    assert isinstance(s, RunSetup) and dist.n_classes == 1
+    # seed 7: the primes above 10007 + 7000, one per insertion fix and size class
+    assert s.seeds == {"insert": 17011, "distribution": 17021, "template1": 17027}
+    record = s.as_dict()
+    assert record["box_hi"] == list(s.box_hi)
+    assert record["total_steps"] == s.fill_steps + s.lift_steps + s.settle_steps

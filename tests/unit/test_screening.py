@@ -9,20 +9,28 @@ import numpy as np
 import pytest
 import torch
 
-from demcal.identification.acceptance import MeasuredCondition
-from demcal.identification.screening import (
-    REPOSE_FEATURES,
-    SHEAR_FEATURES,
-    TABLE3_SPEC,
-    RandomTanhNetwork,
-    Stage,
-    benchmark_screening,
+from demcal.core.experiments import MeasuredCondition
+from demcal.identification.acceptance import (
+    relative_deviation,
+    within_tolerance,
+)
+from demcal.identification.candidate_grid import (
     draw_axes,
     grid_rows,
     grid_size,
     grid_values,
     iter_grid_chunks,
-    screen,
+)
+from demcal.identification.screening import screen
+from demcal.identification.screening_stages import Stage
+from tests.screening_bench import (
+    IN_MEAN,
+    IN_SCALE,
+    REPOSE_FEATURES,
+    SHEAR_FEATURES,
+    RandomTanhNetwork,
+    paper_axes_spec,
+    screen_stand_ins,
 )
 
 SMALL_SPEC = {
@@ -98,7 +106,9 @@ def brute_force(
     method: str = "predict",
 ) -> tuple[list[int], list[dict[str, dict[str, float]]], list[float]]:
     """Row-by-row loop over the product; returns accepted flat indices, their predictions
-    per condition, and the smallest distance of any relative deviation to the tolerance."""
+    per condition, and the smallest distance of any relative deviation to the tolerance.
+
+    Each row is accepted by the pipeline's own rule (:func:`within_tolerance`) on one set."""
     accepted: list[int] = []
     preds: list[dict[str, dict[str, float]]] = []
     margins: list[float] = []
@@ -117,9 +127,10 @@ def brute_force(
                 else:
                     value = float(model.predict(x)[0])
                 row_pred[cond.label][out] = value
-                dev = abs(1.0 - value / exp)
-                margins.append(abs(dev - tol))
-                ok = ok and dev < tol
+                margins.append(abs(float(relative_deviation(value, exp)) - tol))
+            measured = dict(cond.values)
+            single = {out: np.array([v]) for out, v in row_pred[cond.label].items()}
+            ok = ok and bool(within_tolerance(single, measured, tol)[0])
             if not ok:
                 break
         if ok:
@@ -129,17 +140,18 @@ def brute_force(
 
 
 def test_draw_axes_sorted_in_range_and_seeded() -> None:
-    axes = draw_axes(TABLE3_SPEC, seed=3)
-    assert list(axes) == list(TABLE3_SPEC)
-    for name, (low, high, count) in TABLE3_SPEC.items():
+    spec = paper_axes_spec()  # paper Table 3
+    axes = draw_axes(spec, seed=3)
+    assert list(axes) == list(spec)
+    for name, (low, high, count) in spec.items():
         values = axes[name]
         assert values.shape == (count,)
         assert np.all(np.diff(values) >= 0.0)
         assert values.min() >= low and values.max() < high
     assert grid_size(axes) == 6_250_000
-    again = draw_axes(TABLE3_SPEC, seed=3)
-    other = draw_axes(TABLE3_SPEC, seed=4)
-    for name in TABLE3_SPEC:
+    again = draw_axes(spec, seed=3)
+    other = draw_axes(spec, seed=4)
+    for name in spec:
         np.testing.assert_array_equal(axes[name], again[name])
         assert not np.array_equal(axes[name], other[name])
 
@@ -238,8 +250,7 @@ def test_screen_stage_counts_match_brute_force_per_prefix() -> None:
 
 def test_screen_equals_brute_force_torch_predictors() -> None:
     axes = draw_axes(SMALL_SPEC, seed=5)
-    mean = np.array([0.55, 0.55, 0.7, 3000.0, 20.0, 5000.0, 0.7])
-    scale = np.array([0.26, 0.26, 0.12, 290.0, 5.0, 4000.0, 0.2])
+    mean, scale = IN_MEAN, IN_SCALE
     predictors = {
         "mu_psh": (RandomTanhNetwork(7, 15, 11, mean, scale, 0.6, 0.1), SHEAR_FEATURES),
         "rho_b": (RandomTanhNetwork(7, 15, 12, mean, scale, 1700.0, 100.0), SHEAR_FEATURES),
@@ -340,19 +351,22 @@ def test_screen_setup_errors() -> None:
         screen(predictors, axes, FIXED, bad)
 
 
-def test_benchmark_modes_accept_the_same_sets() -> None:
+def test_one_stage_and_marked_then_valid_accept_the_same_sets() -> None:
+    # All four networks in one stage on every set, or the repose network only on the sets the
+    # shear networks marked: the same valid sets, fewer repose evaluations.
     spec = {
         "coefficientFriction": (0.1, 1.0, 12),
         "coefficientRollingFriction": (0.1, 1.0, 12),
         "coefficientRestitution": (0.5, 0.9, 6),
         "density": (2500.0, 3500.0, 6),
     }
-    together = benchmark_screening(spec=spec, chunk_size=1000, num_threads=1)
-    sequential = benchmark_screening(spec=spec, chunk_size=1000, num_threads=1, sequential=True)
-    assert together.n_total == 12 * 12 * 6 * 6
-    assert together.n_accepted > 0
+    together = screen_stand_ins(spec, chunk_size=1000, num_threads=1)
+    sequential = screen_stand_ins(spec, chunk_size=1000, num_threads=1, sequential=True)
+    assert together.n_total == sequential.n_total == 12 * 12 * 6 * 6
+    marked, valid = sequential.stage_counts.values()
+    assert 0 < valid < marked < together.n_total
+    assert together.n_accepted == valid
     np.testing.assert_array_equal(together.indices, sequential.indices)
-    assert together.sets_per_second > 0.0
 
 
 class InPlacePredictor:

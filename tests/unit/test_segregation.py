@@ -6,19 +6,23 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.application.chute_cooler.segregation import (
+from demcal.application.chute_cooler.box_layers import (
     LAYERS,
     Box,
-    analyse_segregation,
     assign_classes,
     layer_class_volumes,
     layer_table,
+    table_volumes,
+)
+from demcal.application.chute_cooler.segregation import (
     mean_radii,
     segregation_index,
-    segregation_time_series,
     sorted_volumes,
+)
+from demcal.application.chute_cooler.steady_segregation import (
+    analyse_segregation,
+    segregation_time_series,
     steady_window,
-    table_volumes,
 )
 
 RADII = [1.0e-3, 0.8e-3, 0.5e-3]

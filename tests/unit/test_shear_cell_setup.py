@@ -9,19 +9,14 @@ import math
 import pytest
 
 from demcal.core.config import validate_config
-from demcal.particles.size_distribution import monodisperse, sinter_fines
+from demcal.core.config_values import SetupError
+from demcal.particles.material import material_setup, rayleigh_time, round_down_sig, time_step
+from demcal.particles.run_setup import prime_seed, steps_for
+from demcal.particles.size_distribution import monodisperse, sinter_fines, size_distribution
 from demcal.virtual_tests.shear_cell.setup import (
-    SetupError,
     inertial_number,
-    material_setup,
-    prime_seed,
-    rayleigh_time,
-    round_down_sig,
     shear_cell_setup,
     shear_cell_youngs_modulus,
-    size_distribution,
-    steps_for,
-    time_step,
 )
 
 CASE = {
@@ -138,8 +133,9 @@ def test_prime_seeds_are_distinct_large_primes() -> None:
     assert len(set(seeds)) == 8 and min(seeds) > 10000
     for s in seeds:
         assert all(s % d for d in range(2, int(s**0.5) + 1))
-    assert prime_seed(7, 3) == prime_seed(7, 3)
-    assert prime_seed(7, 0) != prime_seed(8, 0)
+    # Seed 7: the primes above 10007 + 7000 = 17007.
+    assert [prime_seed(7, k) for k in range(4)] == [17011, 17021, 17027, 17029]
+    assert prime_seed(8, 0) == 18013  # the first prime above 18007
 
 
 def test_steps_and_inertial_number() -> None:

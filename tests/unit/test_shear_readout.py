@@ -8,7 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.engine_io.output import MissingColumnError, read_print_file
+from demcal.engine_io.fix_output import read_print_file
+from demcal.engine_io.output_errors import MissingColumnError
 from demcal.virtual_tests.shear_cell.readout import (
     REQUIRED_COLUMNS,
     overlap_area,
@@ -247,8 +248,11 @@ def test_from_print_file(tmp_path: Path) -> None:
 
 def test_plateau_options_are_passed_on() -> None:
     table = synthetic_run(CYCLES[:1], seed=5)
+    default = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
     strict = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G, min_fraction=0.9)
-    # A plateau covering 90 % of the phase would include the rise, so it is not steady.
+    # A plateau covering 90 % of the phase would include the rise, so it is not steady; with
+    # the default fraction the same pre-shear is.
+    assert default["steady_psh"].iloc[0]
     assert not strict["steady_psh"].iloc[0]
 
 

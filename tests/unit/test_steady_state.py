@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from demcal.virtual_tests.steady_state import detect_plateau, mser_truncation
+from demcal.core.steady_state import detect_plateau, mser_truncation
 
 T = np.linspace(0.0, 10.0, 2000)
 SEEDS = range(5)

@@ -1,4 +1,5 @@
-"""Tests of demcal.decks.stl_mesh: surface areas, closedness, orientation, STL round trips."""
+"""Tests of the mesh primitives, triangle surfaces and STL files of demcal.decks: surface areas,
+closedness, orientation, STL round trips."""
 
 from __future__ import annotations
 
@@ -9,25 +10,24 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from demcal.decks.stl_mesh import (
-    StlFormatError,
+from demcal.decks.mesh_primitives import (
     annulus,
     box_open_top,
     cylinder_shell,
     disc,
+    quad,
+    rectangle,
+)
+from demcal.decks.stl_file import StlFormatError, read_stl, write_stl_ascii, write_stl_binary
+from demcal.decks.triangle_surface import (
     enclosed_volume,
     is_closed,
     merge,
-    quad,
-    read_stl,
-    rectangle,
     rotate_z,
     surface_area,
     translate,
     triangle_areas,
     triangle_normals,
-    write_stl_ascii,
-    write_stl_binary,
 )
 
 R, H, N = 0.0366, 0.055, 64  # a dCylDp-20-sized cell: radius and height in m

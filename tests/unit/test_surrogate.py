@@ -15,9 +15,12 @@ import torch
 from sklearn.utils.estimator_checks import parametrize_with_checks
 from threadpoolctl import threadpool_limits
 
+from demcal.surrogates.data_split import split_indices
 from demcal.surrogates.figures import parity_plot, r2_vs_hidden_size
+from demcal.surrogates.hidden_size_sweep import sweep_hidden_sizes
 from demcal.surrogates.metrics import regression_metrics
-from demcal.surrogates.network import MLPSurrogate, split_indices, sweep_hidden_sizes
+from demcal.surrogates.network import MLPSurrogate
+from tests.figures import ink, read_png, saved_figures
 
 FEATURES = [
     "coefficientFriction",
@@ -250,18 +253,31 @@ def test_full_paper_sweep_runs_within_a_minute() -> None:
 
 
 # ----------------------------------------------------------------- figures
-def _is_png(path: Path) -> bool:
-    return path.stat().st_size > 1000 and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-
-
-def test_parity_plot_writes_png(tmp_path: Path) -> None:
+def test_parity_plot_draws_the_samples_against_the_diagonal(tmp_path: Path) -> None:
     rng = np.random.default_rng(15)
     y = rng.uniform(0.4, 0.8, 60)
-    out = parity_plot(y, y + rng.normal(0.0, 0.02, 60), "ANN, mu_psh", tmp_path / "f" / "p.png")
-    assert _is_png(out)
+    pred = y + rng.normal(0.0, 0.02, 60)
+    with saved_figures() as figures:
+        out = parity_plot(y, pred, "ANN, mu_psh", tmp_path / "f" / "p.png")
+    ((ax,),) = [f.axes for f in figures]
+    (points,) = ax.collections
+    np.testing.assert_array_equal(points.get_offsets(), np.column_stack([y, pred]))
+    (diagonal,) = ax.lines
+    np.testing.assert_array_equal(diagonal.get_xdata(), diagonal.get_ydata())
+    # Equal axes that hold every sample with a margin, the diagonal from corner to corner.
+    low, high = ax.get_xlim()
+    assert ax.get_ylim() == (low, high)
+    assert low < min(y.min(), pred.min()) < max(y.max(), pred.max()) < high
+    assert tuple(diagonal.get_xdata()) == (low, high)
+    r2 = regression_metrics(y, pred)["r2"]
+    assert r2 == pytest.approx(1.0 - 0.02**2 / (0.4**2 / 12.0), abs=0.02)  # noise / spread
+    assert ax.get_title() == f"ANN, mu_psh: $R^2$ = {r2:.3f}"
+    image = read_png(out)
+    assert image.shape == (675, 675, 3)  # 4.5 in at 150 dpi
+    assert 0.02 < ink(image).mean() < 0.5
 
 
-def test_r2_vs_hidden_size_writes_png(tmp_path: Path) -> None:
+def test_r2_vs_hidden_size_marks_both_selected_networks(tmp_path: Path) -> None:
     sizes = np.arange(5, 41)
     table = pd.DataFrame(
         {
@@ -270,14 +286,26 @@ def test_r2_vs_hidden_size_writes_png(tmp_path: Path) -> None:
             "val_mse": 0.001 + 1e-6 * (sizes - 12) ** 2,
         }
     )
-    out = r2_vs_hidden_size(table, tmp_path / "r2.png")
-    assert _is_png(out)
+    shuffled = table.sample(frac=1.0, random_state=3)
+    with saved_figures() as figures:
+        out = r2_vs_hidden_size(shuffled, tmp_path / "r2.png")
+    ((ax,),) = [f.axes for f in figures]
+    (curve,) = ax.lines
+    np.testing.assert_array_equal(curve.get_xdata(), sizes)  # in order of size
+    np.testing.assert_allclose(curve.get_ydata(), table["test_r2"])
+    # Lowest generalisation error at 12 neurons (circle), highest test R^2 at 15 (star).
+    circle, star = ax.collections
+    np.testing.assert_allclose(circle.get_offsets(), [[12, 0.95 - 0.0009]])
+    np.testing.assert_allclose(star.get_offsets(), [[15, 0.95]])
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels == ["lowest generalisation error: 12", "highest test $R^2$ (paper rule): 15"]
+    assert read_png(out).shape == (600, 900, 3)  # 6 x 4 in at 150 dpi
     with pytest.raises(KeyError, match="val_mse"):
         r2_vs_hidden_size(table.drop(columns="val_mse"), tmp_path / "bad.png")
 
 
 def test_split_groups_keeps_groups_together():
-    from demcal.surrogates.network import split_groups
+    from demcal.surrogates.data_split import split_groups
 
     groups = np.repeat([f"c{k:04d}" for k in range(20)], 4)  # 20 parameter sets x 4 loads
     train, val, test = split_groups(groups, seed=3)

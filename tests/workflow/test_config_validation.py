@@ -1,5 +1,6 @@
 """Snakemake stops on a bad configuration before any job runs, naming the key."""
 
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -42,3 +43,46 @@ def test_value_out_of_range_stops_workflow(tmp_path):
     res = _dry_run(tmp_path, {"engine": {"threads": -2}})
     assert res.returncode != 0
     assert "engine.threads" in res.stderr + res.stdout
+
+
+def test_misspelt_contact_parameter_stops_a_real_run_before_any_job(tmp_path):
+    """A real (not dry) run of the tiny study with a misspelt design range: Snakemake stops
+    while reading the configuration, names the key and suggests the name, and runs no job."""
+    work = tmp_path / "study"
+    shutil.copytree(ROOT / "config", work / "config")
+    config = yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text())
+    config["design"]["ranges"] = {
+        "coefficientFrction": [0.1, 0.9],
+        "coefficientRollingFriction": [0.1, 0.9],
+        "coefficientRestitution": [0.5, 0.9],
+        "density": [2500.0, 3500.0],
+    }
+    (work / "config.yaml").write_text(yaml.safe_dump(config))
+    res = subprocess.run(
+        [
+            *SNAKEMAKE,
+            "results/design/cases.csv",  # before --configfile, which takes several values
+            "--snakefile",
+            str(ROOT / "Snakefile"),
+            "--directory",
+            str(work),
+            "--cores",
+            "1",
+            "--configfile",
+            str(work / "config.yaml"),
+        ],
+        capture_output=True,
+        text=True,
+        cwd=work,
+        timeout=300,
+    )
+    out = res.stderr + res.stdout
+    assert res.returncode != 0
+    assert (
+        "design.ranges.coefficientFrction: unknown contact parameter "
+        "(did you mean coefficientFriction?)" in out
+    )
+    assert "config.yaml" in out
+    assert "Job stats" not in out and "rule design" not in out
+    assert not (work / "results").exists()
+    assert not (work / "logs").exists()

@@ -13,11 +13,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 import yaml
 
 from demcal.core.config import validate_config
+from demcal.core.experiments import load_experiment
 from demcal.discrepancy.synthetic import study_config, write_hidden_effect_experiment
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -117,8 +119,19 @@ def summary(work: Path) -> dict:
 
 @pytest.mark.parametrize("name", list(SCENARIOS))
 def test_all_outputs_written(studies, name):
+    out = studies[name] / "results" / "discrepancy"
     for output in OUTPUTS:
-        assert (studies[name] / "results" / "discrepancy" / output).is_file(), (name, output)
+        assert (out / output).is_file(), (name, output)
+    # One row of the before/after table per measured value, its misfit before the effect
+    # finite; the summary's gap is the root mean square of those misfits.
+    experiment = load_experiment(studies[name] / EXPERIMENT)
+    measured = sum(len(c.values) for c in experiment.shear_conditions)
+    measured += experiment.angle_of_repose is not None
+    gap = pd.read_csv(out / "gap_before_after.csv")
+    assert len(gap) == measured, (name, len(gap))
+    assert np.isfinite(gap[["measured", "sigma", "z_before"]].to_numpy()).all(), name
+    result = summary(studies[name])
+    assert result["gap_before"] == pytest.approx(np.sqrt(np.mean(gap["z_before"] ** 2)), rel=1e-4)
     config = (studies[name] / "config" / "config.yaml").read_text()
     assert "truth" not in config
     assert "parameters" not in yaml.safe_load((studies[name] / EXPERIMENT).read_text())
@@ -154,4 +167,7 @@ def test_no_hidden_effect_names_none(studies):
 def test_cohesion_signature_weakens_with_stress(studies):
     ranking = pd.read_csv(studies["cohesion"] / "results" / "discrepancy" / "ranking.csv")
     signature = ranking.set_index("candidate").loc["cohesion", "signature"]
-    assert "rho_b +" in signature and "weakens with normal stress" in signature, signature
+    # Cohesion loosens a packing (the packing fraction of spheres falls as the cohesive force
+    # grows against the weight, Yang, Zou & Yu 2000) and its extra shear strength is a larger
+    # share of the stress at low normal stress.
+    assert "rho_b -" in signature and "weakens with normal stress" in signature, signature

@@ -40,6 +40,8 @@ rule application_run:
         status=f"{APPLICATION_RUN}/status.json",
     log:
         f"{LOGS}/application/run.log",
+    benchmark:
+        f"{RESULTS}/benchmarks/application/chute_cooler.tsv"
     params:
         command=lambda wildcards: config["engine"]["command"],
     conda:

@@ -1,4 +1,5 @@
-# Stage 3: all bulk values in one tidy table (one row per case and load condition).
+# Stage 3: all bulk values in one tidy table (one row per case and load condition) and the run
+# times of the DEM cases.
 
 
 rule collect_dataset:
@@ -21,3 +22,28 @@ rule collect_dataset:
         CONDA_ENV
     script:
         "../../scripts/collect_dataset.py"
+
+
+rule run_times:
+    input:
+        benchmarks=[
+            CASE_BENCHMARK.format(stage="cases", test=test, case=case)
+            for test in TESTS
+            for case in CASES[test]
+        ],
+    output:
+        table=report(
+            f"{RESULTS}/bulk/run_times.csv", category="Runs", caption="../report/run_times.rst"
+        ),
+        figure=report(
+            f"{RESULTS}/bulk/run_times.png", category="Runs", caption="../report/run_times.rst"
+        ),
+    log:
+        f"{LOGS}/bulk/run_times.log",
+    params:
+        cases=[[test, case] for test in TESTS for case in CASES[test]],
+    localrule: True
+    conda:
+        CONDA_ENV
+    script:
+        "../../scripts/run_times.py"

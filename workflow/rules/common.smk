@@ -1,5 +1,13 @@
 # Shared set-up: validated configuration, the case list and output locations.
-from demcal.design.cases import TESTS, case_ids, case_row, design_from_config, verification_case_ids
+from demcal.design.cases import (
+    TESTS,
+    case_ids,
+    case_row,
+    design_from_config,
+    verification_case_ids,
+    verification_engines,
+    verification_threads,
+)
 from demcal.core.config import validate_config
 
 validate_config(config, source=", ".join(str(f) for f in workflow.configfiles) or "config")
@@ -17,6 +25,24 @@ OUTPUTS_TRAINED = ["mu_psh", "mu_sh", "rho_b", "aor"]
 DESIGN = design_from_config(config)
 CASES = {test: case_ids(config, DESIGN, test) for test in TESTS}
 VERIFICATION_CASES = {test: verification_case_ids(config, test) for test in TESTS}
+# Engines of the verification runs (name -> command); each runs the cases in
+# results/verification/<name>/.
+VERIFICATION_ENGINES = verification_engines(config)
+VERIFICATION_THREADS = verification_threads(config)
+
+
+def engine_command(stage):
+    """Command template of the engine that runs the cases of `stage`."""
+    if stage.startswith("verification/"):
+        return VERIFICATION_ENGINES[stage.split("/", 1)[1]]
+    return config["engine"]["command"]
+
+
+def engine_threads(stage):
+    """Threads or MPI ranks of one run of `stage`."""
+    if stage.startswith("verification/"):
+        return VERIFICATION_THREADS
+    return config["engine"]["threads"]
 
 
 def resource(kind, key, default):

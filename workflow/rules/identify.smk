@@ -1,5 +1,6 @@
 # Stage 5: screen the candidate grid against the measurements; Table 5, Figs. 6-9, the
-# identified parameter set, and a verification DEM run of both tests at that set.
+# identified parameter set, and a verification DEM run of both tests at that set on each engine
+# of verification.engines.
 
 FIGURES = {
     "fig6": "fig6_box_ssc.png",
@@ -55,10 +56,10 @@ rule render_verification:
     input:
         identified=IDENTIFIED,
     output:
-        deck=f"{RESULTS}/verification/{{test}}/{{case}}/in.{{test}}",
-        info=f"{RESULTS}/verification/{{test}}/{{case}}/case.json",
+        deck=f"{RESULTS}/verification/{{engine}}/{{test}}/{{case}}/in.{{test}}",
+        info=f"{RESULTS}/verification/{{engine}}/{{test}}/{{case}}/case.json",
     log:
-        f"{LOGS}/render/verification/{{test}}/{{case}}.log",
+        f"{LOGS}/render/verification/{{engine}}/{{test}}/{{case}}.log",
     localrule: True
     conda:
         CONDA_ENV
@@ -68,11 +69,15 @@ rule render_verification:
 
 rule verification_table:
     input:
-        bulk=[
-            f"{RESULTS}/verification/{test}/{case}/bulk.csv"
-            for test in TESTS
-            for case in VERIFICATION_CASES[test]
-        ],
+        # One list of bulk files per engine, named bulk_<engine>.
+        **{
+            f"bulk_{engine}": [
+                f"{RESULTS}/verification/{engine}/{test}/{case}/bulk.csv"
+                for test in TESTS
+                for case in VERIFICATION_CASES[test]
+            ]
+            for engine in VERIFICATION_ENGINES
+        },
         experiment=config["experiment"],
         identified=IDENTIFIED,
     output:
@@ -86,6 +91,8 @@ rule verification_table:
         f"{LOGS}/verification/verification_table.log",
     params:
         tolerance=config["screening"]["tolerance"],
+        engines=VERIFICATION_ENGINES,
+        threads=VERIFICATION_THREADS,
     localrule: True
     conda:
         CONDA_ENV

@@ -3,7 +3,7 @@
 from pathlib import Path
 
 from demcal.bulk.dataset import write_case_rows
-from demcal.decks.render import render_case
+from demcal.virtual_tests.deck import render_case
 from demcal.core.rule_log import rule_log
 
 
@@ -22,6 +22,10 @@ rule render_case:
             render_case(wildcards.test, params.case, config, Path(output.deck).parent)
 
 
+# Wall-clock time, memory and CPU of every engine run (the study's cases: rule run_times).
+CASE_BENCHMARK = f"{RESULTS}/benchmarks/{{stage}}/{{test}}/{{case}}.tsv"
+
+
 rule run_case:
     input:
         deck=f"{RESULTS}/{{stage}}/{{test}}/{{case}}/in.{{test}}",
@@ -30,9 +34,11 @@ rule run_case:
         status=f"{RESULTS}/{{stage}}/{{test}}/{{case}}/status.json",
     log:
         f"{LOGS}/run/{{stage}}/{{test}}/{{case}}.log",
+    benchmark:
+        CASE_BENCHMARK
     params:
-        command=lambda wildcards: config["engine"]["command"],
-    threads: config["engine"]["threads"]
+        command=lambda wildcards: engine_command(wildcards.stage),
+    threads: lambda wildcards: engine_threads(wildcards.stage)
     resources:
         runtime=resource("dem_case", "runtime", 60),
         mem_mb=resource("dem_case", "mem_mb", 2000),

@@ -5,7 +5,8 @@ namespace dem {
 
 // No cohesion.
 struct CohesionNone {
-  static void apply(const ContactInput&, const PairParams&, ContactResult&) {}
+  static void apply(const ContactInput&, const PairParams&, const ContactStep&, double*,
+                    ContactResult&) {}
 };
 
 }  // namespace dem

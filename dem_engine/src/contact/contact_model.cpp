@@ -19,9 +19,11 @@
 
 namespace dem {
 
-std::size_t parse_model_spec(const std::vector<std::string>& w, std::size_t pos, ModelSpec& spec,
-                             bool allow_trailing) {
-  auto expect = [&](const char* type, std::initializer_list<const char*> names) -> std::string {
+std::size_t parse_model_types(const std::vector<std::string>& w, std::size_t pos,
+                              ModelSpec& spec) {
+  // LIGGGHTS grammar: model, tangential, [cohesion], [rolling_friction], [surface] in this
+  // order and at most once each.
+  auto choose = [&](const char* type, std::initializer_list<const char*> names) -> std::string {
     if (pos + 1 >= w.size()) throw EngineError(std::string("missing value after '") + type + "'");
     const std::string& name = w[pos + 1];
     for (const char* n : names)
@@ -36,44 +38,50 @@ std::size_t parse_model_spec(const std::vector<std::string>& w, std::size_t pos,
   };
   if (pos >= w.size() || w[pos] != "model")
     throw EngineError("expected 'model hertz tangential history ...'");
-  expect("model", {"hertz"});
+  choose("model", {"hertz"});
   if (pos >= w.size() || w[pos] != "tangential")
     throw EngineError("expected 'tangential history' after 'model hertz'");
-  expect("tangential", {"history"});
-  while (pos < w.size()) {
-    const std::string& key = w[pos];
-    if (key == "cohesion") {
-      expect("cohesion", {"sjkr", "off"});
-      spec.cohesion_sjkr = w[pos - 1] == "sjkr";
-    } else if (key == "rolling_friction") {
-      expect("rolling_friction", {"epsd2", "off"});
-      spec.rolling_epsd2 = w[pos - 1] == "epsd2";
-    } else if (key == "surface") {
-      expect("surface", {"default"});
-    } else if (key == "limitForce" || key == "tangential_damping") {
-      if (pos + 1 >= w.size()) throw EngineError("missing value after '" + key + "'");
-      const bool on = parse_yes_no(w[pos + 1], key);
-      if (key == "limitForce") spec.options.limit_force = on;
-      else spec.options.tangential_damping = on;
-      pos += 2;
-    } else if (allow_trailing) {
-      break;
-    } else {
-      throw EngineError("unknown pair_style gran keyword '" + key + "'");
-    }
-  }
+  choose("tangential", {"history"});
+  if (pos < w.size() && w[pos] == "cohesion")
+    spec.cohesion_sjkr = choose("cohesion", {"sjkr", "off"}) == "sjkr";
+  if (pos < w.size() && w[pos] == "rolling_friction")
+    spec.rolling_epsd2 = choose("rolling_friction", {"epsd2", "off"}) == "epsd2";
+  if (pos < w.size() && w[pos] == "surface") choose("surface", {"default"});
   return pos;
+}
+
+bool parse_model_keyword(const std::vector<std::string>& w, std::size_t& pos, ModelSpec& spec) {
+  const std::string& key = w[pos];
+  bool* flag = nullptr;
+  if (key == "limitForce") flag = &spec.options.limit_force;
+  else if (key == "tangential_damping") flag = &spec.options.tangential_damping;
+  else if (key == "tangential_reduce" && spec.cohesion_sjkr) flag = &spec.options.tangential_reduce;
+  if (!flag) return false;
+  if (pos + 1 >= w.size()) throw EngineError("missing value after '" + key + "'");
+  const std::string& value = w[pos + 1];
+  if (value != "on" && value != "off")
+    throw EngineError("'" + key + "' expects 'on' or 'off', got '" + value + "'");
+  *flag = value == "on";
+  pos += 2;
+  return true;
+}
+
+void parse_pair_model(const std::vector<std::string>& w, std::size_t pos, ModelSpec& spec) {
+  pos = parse_model_types(w, pos, spec);
+  while (pos < w.size())
+    if (!parse_model_keyword(w, pos, spec))
+      throw EngineError("unknown argument or wrong keyword order: '" + w[pos] + "'");
 }
 
 namespace {
 
 template <class Cohesion, class Rolling>
-inline void contact_law(const ContactInput& c, const PairParams& p, const ContactOptions& opt,
-                        double dt, double* history, ContactResult& result) {
-  const double gamma_t = NormalHertz::apply(c, p, opt, result);
-  Cohesion::apply(c, p, result);
-  TangentialHistory::apply(c, p, gamma_t, dt, history, result);
-  Rolling::apply(c, p, dt, history + 3, result);
+inline void contact_law(const ContactInput& c, const PairParams& p, const ContactStep& step,
+                        double* history, ContactResult& result) {
+  NormalHertz::apply(c, p, step, history, result);
+  Cohesion::apply(c, p, step, history, result);
+  TangentialHistory::apply(c, p, step, history, result);
+  Rolling::apply(c, p, step, history, result);
 }
 
 template <class Cohesion, class Rolling>
@@ -81,9 +89,9 @@ class ComposedModel final : public ContactModel {
  public:
   using ContactModel::ContactModel;
 
-  void evaluate(const ContactInput& c, const PairParams& p, double dt, double* history,
-                ContactResult& result) const override {
-    contact_law<Cohesion, Rolling>(c, p, spec().options, dt, history, result);
+  void evaluate(const ContactInput& c, const PairParams& p, const ContactStep& step,
+                double* history, ContactResult& result) const override {
+    contact_law<Cohesion, Rolling>(c, p, step, history, result);
   }
 
   void pair_forces(PairForceArgs& a) const override {
@@ -98,7 +106,10 @@ class ComposedModel final : public ContactModel {
     Particles& P = a.atoms;
     const std::size_t n = P.size();
     const int nthreads = static_cast<int>(a.thread_force.size());  // 1 for small systems
-    const ContactOptions opt = spec().options;
+    ContactStep step;
+    step.options = spec().options;
+    step.dt = a.dt;
+    step.update_history = a.update_history;
     double worst_ratio = 0.0;
     long worst_tag = -1;
     long contacts = 0;
@@ -108,6 +119,8 @@ class ComposedModel final : public ContactModel {
     const double* rad = P.radius.data();
     const double* mass = P.rmass.data();
     const int* type = P.type.data();
+    const std::uint32_t* mask = P.mask.data();
+    const std::uint32_t freeze_bit = a.freeze_bit;
     const int* first = a.list.first.data();
     const int* partner = a.list.partner.data();
     double* hist_all = a.list.history.data();
@@ -148,8 +161,10 @@ class ComposedModel final : public ContactModel {
         const Vec3 xi = x[i];
         const double ri = rad[i];
         // Pass 1 sorts the listed pairs into touching ones, without branching on a
-        // coin-flip condition, and clears the history of contacts that just opened (a byte
-        // flag per pair keeps the history of pairs apart out of the cache).
+        // coin-flip condition, and flags contacts that opened. As in LIGGGHTS, the history of
+        // a pair that opened is kept while the pair stays in the list (a contact that closes
+        // again before the next neighbour build resumes it); the build drops it (see
+        // NeighborList::build).
         int m = 0;
         for (int k = first[i]; k < k_end; ++k) {
           const int j = partner[k];
@@ -159,10 +174,7 @@ class ComposedModel final : public ContactModel {
           const bool apart = norm2(d) >= radsum * radsum;
           hits[m] = k;
           m += !apart;
-          if (apart && touching[k]) {
-            touching[k] = 0;
-            std::fill_n(hist_all + static_cast<std::size_t>(k) * kHistorySize, kHistorySize, 0.0);
-          }
+          if (apart && touching[k]) touching[k] = 0;
         }
         if (m == 0) continue;
         contacts += m;
@@ -185,6 +197,10 @@ class ComposedModel final : public ContactModel {
           c.rj = rj;
           c.r_eff = ri * rj / radsum;
           c.m_eff = mi * mass[j] / (mi + mass[j]);
+          if (freeze_bit) {  // rare: branch only then
+            if (mask[i] & freeze_bit) c.m_eff = mass[j];
+            if (mask[j] & freeze_bit) c.m_eff = mi;
+          }
           c.cri = ri - 0.5 * c.overlap;
           c.crj = rj - 0.5 * c.overlap;
           c.v_rel = vi - v[j];
@@ -200,7 +216,7 @@ class ComposedModel final : public ContactModel {
           const ContactInput& c = inputs[h];
           touching[k] = 1;
           ContactResult res;
-          contact_law<Cohesion, Rolling>(c, a.material.get(type_i, type[j]), opt, a.dt,
+          contact_law<Cohesion, Rolling>(c, a.material.get(type_i, type[j]), step,
                                          hist_all + static_cast<std::size_t>(k) * kHistorySize,
                                          res);
           fi += res.force;

@@ -1,4 +1,5 @@
 #pragma once
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,18 +13,24 @@
 namespace dem {
 
 // Which sub-models make up the contact law (LIGGGHTS `model hertz tangential history
-// [cohesion sjkr] [rolling_friction epsd2] [surface default]` + keyword/value options).
+// [cohesion sjkr|off] [rolling_friction epsd2|off] [surface default]` in this order, then
+// `limitForce`, `tangential_damping` and, with cohesion sjkr, `tangential_reduce`, each on|off).
 struct ModelSpec {
   bool cohesion_sjkr = false;
   bool rolling_epsd2 = false;
   ContactOptions options;
 };
 
-// Parses the model words starting at words[pos]. Stops at the first word that is neither a
-// model type nor a model keyword when `allow_trailing` (wall/gran continues with primitive or
-// mesh), otherwise such a word is an error. Returns the index of the first unparsed word.
-std::size_t parse_model_spec(const std::vector<std::string>& words, std::size_t pos,
-                             ModelSpec& spec, bool allow_trailing);
+// Parses the model types starting at words[pos] (model ... [surface default]); returns the
+// index of the first word after them.
+std::size_t parse_model_types(const std::vector<std::string>& words, std::size_t pos,
+                              ModelSpec& spec);
+// Parses one `keyword on|off` of the chosen models at words[pos] and advances pos past it;
+// returns false (pos unchanged) when words[pos] is not such a keyword.
+bool parse_model_keyword(const std::vector<std::string>& words, std::size_t& pos,
+                         ModelSpec& spec);
+// pair_style gran: the model types, then only model keywords.
+void parse_pair_model(const std::vector<std::string>& words, std::size_t pos, ModelSpec& spec);
 
 struct PairForceArgs {
   Particles& atoms;
@@ -31,6 +38,10 @@ struct PairForceArgs {
   const MaterialTable& material;
   const Domain& domain;
   double dt;
+  bool update_history;  // false while a run is set up (see ContactStep)
+  // Group bit of the first fix freeze (0 if none): a pair with a frozen particle has the
+  // effective mass of the other particle, as in LIGGGHTS.
+  std::uint32_t freeze_bit;
   // [thread][particle] for threads >= 1 (thread 0 adds into atoms), zeroed by the callee
   std::vector<std::vector<Vec3>>& thread_force;
   std::vector<std::vector<Vec3>>& thread_torque;
@@ -47,8 +58,8 @@ class ContactModel {
   virtual ~ContactModel() = default;
   const ModelSpec& spec() const { return spec_; }
   // One contact: updates history (kHistorySize doubles) and fills result.
-  virtual void evaluate(const ContactInput& c, const PairParams& p, double dt, double* history,
-                        ContactResult& result) const = 0;
+  virtual void evaluate(const ContactInput& c, const PairParams& p, const ContactStep& step,
+                        double* history, ContactResult& result) const = 0;
   // All particle pairs of the neighbour list; sets f and torque of every particle to the sum
   // of its pair forces and torques.
   virtual void pair_forces(PairForceArgs& args) const = 0;

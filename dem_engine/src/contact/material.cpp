@@ -45,14 +45,18 @@ std::vector<double> per_pair(const PropertyStore& props, const char* name, int n
 
 }  // namespace
 
-void MaterialTable::build(const PropertyStore& props, int n, bool soft, bool need_rolling,
-                          bool need_cohesion) {
+void MaterialTable::build(const PropertyStore& props, int n, bool soft, bool hard,
+                          bool need_rolling, bool need_cohesion) {
   youngs_ = per_type(props, "youngsModulus", n);
   poisson_ = per_type(props, "poissonsRatio", n);
   for (int t = 0; t < n; ++t) {
     if (!(youngs_[t] > 0.0)) throw EngineError("youngsModulus must be > 0");
     if (youngs_[t] < 5e6 && !soft)
-      throw EngineError("youngsModulus below 5e6 Pa requires 'soft_particles yes'");
+      throw EngineError("youngsModulus >= 5e6 required for SI units (use command "
+                        "'soft_particles yes' to override)");
+    if (youngs_[t] > 1e9 && !hard)
+      throw EngineError("youngsModulus <= 1e9 required for SI units (use command "
+                        "'hard_particles yes' to override)");
     if (!(poisson_[t] > 0.0 && poisson_[t] <= 0.5))
       throw EngineError("poissonsRatio must be in (0, 0.5]");
   }

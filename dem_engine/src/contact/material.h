@@ -10,9 +10,10 @@ namespace dem {
 class MaterialTable {
  public:
   // Throws EngineError naming the property when one is missing, has the wrong size or an
-  // invalid value (Y < 5e6 Pa without soft_particles, e outside (0.05, 1], ...).
-  void build(const PropertyStore& props, int ntypes, bool soft_particles, bool need_rolling,
-             bool need_cohesion);
+  // invalid value (as LIGGGHTS 3.8 in SI units: Y < 5e6 Pa without soft_particles yes,
+  // Y > 1e9 Pa without hard_particles yes, e outside (0.05, 1], ...).
+  void build(const PropertyStore& props, int ntypes, bool soft_particles, bool hard_particles,
+             bool need_rolling, bool need_cohesion);
   const PairParams& get(int ti, int tj) const { return table_[(ti - 1) * n_ + (tj - 1)]; }
   int ntypes() const { return n_; }
   double youngs_modulus(int t) const { return youngs_[t - 1]; }

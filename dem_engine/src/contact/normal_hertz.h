@@ -6,10 +6,10 @@
 namespace dem {
 
 // Hertz normal contact with restitution-based damping (LIGGGHTS `model hertz`).
-// Sets result.fn, result.kn and result.kt; returns the tangential damping coefficient gamma_t.
+// Sets fn (and fn_limit to it), kn, kt and gamma_t.
 struct NormalHertz {
-  static double apply(const ContactInput& c, const PairParams& p, const ContactOptions& opt,
-                      ContactResult& result) {
+  static void apply(const ContactInput& c, const PairParams& p, const ContactStep& step,
+                    double* /*history*/, ContactResult& result) {
     const double sqrt_rd = std::sqrt(c.r_eff * c.overlap);
     const double sn = 2.0 * p.y_star * sqrt_rd;
     const double st = 8.0 * p.g_star * sqrt_rd;
@@ -19,11 +19,12 @@ struct NormalHertz {
     const double gamma_t = -k56 * p.beta * std::sqrt(st * c.m_eff);
     const double vn = dot(c.v_rel, c.n);
     double fn = kn * c.overlap - gamma_n * vn;
-    if (opt.limit_force && fn < 0.0) fn = 0.0;
+    if (step.options.limit_force && fn < 0.0) fn = 0.0;
     result.fn = fn;
+    result.fn_limit = fn;
     result.kn = kn;
     result.kt = st;
-    return opt.tangential_damping ? gamma_t : 0.0;
+    result.gamma_t = step.options.tangential_damping ? gamma_t : 0.0;
   }
 };
 

@@ -5,7 +5,8 @@ namespace dem {
 
 // No rolling resistance.
 struct RollingNone {
-  static void apply(const ContactInput&, const PairParams&, double, double*, ContactResult&) {}
+  static void apply(const ContactInput&, const PairParams&, const ContactStep&, double*,
+                    ContactResult&) {}
 };
 
 }  // namespace dem

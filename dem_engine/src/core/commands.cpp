@@ -70,7 +70,7 @@ void cmd_pair_style(Simulation& s, const std::vector<std::string>& a) {
   if (a.empty() || a[0] != "gran")
     throw EngineError("only pair_style gran is supported");
   ModelSpec spec;
-  parse_model_spec(a, 1, spec, false);
+  parse_pair_model(a, 1, spec);
   s.pair = make_contact_model(spec);
 }
 
@@ -205,12 +205,15 @@ void cmd_delete_atoms(Simulation& s, const std::vector<std::string>& a) {
   } else {
     throw EngineError("delete_atoms: expected region or group, got '" + a[0] + "'");
   }
+  bool compress = true;  // LAMMPS default: the remaining particles get the ids 1..N
   for (std::size_t k = 2; k < a.size(); k += 2) {
-    // LIGGGHTS/LAMMPS options that do not change the result for granular atoms.
-    if (a[k] == "compress" && k + 1 < a.size()) continue;
-    throw EngineError("unsupported delete_atoms keyword '" + a[k] + "'");
+    if (a[k] != "compress") throw EngineError("unsupported delete_atoms keyword '" + a[k] + "'");
+    if (k + 1 >= a.size() || (a[k + 1] != "yes" && a[k + 1] != "no"))
+      throw EngineError("delete_atoms compress expects yes or no");
+    compress = a[k + 1] == "yes";
   }
   s.atoms.remove(del);
+  if (compress) s.neighbor.retag(s.atoms.renumber_tags());
   s.particles_changed();
 }
 
@@ -219,15 +222,24 @@ void cmd_fix(Simulation& s, const std::vector<std::string>& a, const Command& co
   const auto& registry = fix_registry();
   auto it = registry.find(a[2]);
   if (it == registry.end()) throw EngineError("unknown fix style '" + a[2] + "'");
-  auto fix = it->second(s, command);
-  for (auto& existing : s.fixes)
-    if (existing->id() == a[0]) {
-      // LAMMPS semantics: a fix with an existing ID replaces it in place.
-      s.properties.remove_owned_by(a[0]);
-      existing = std::move(fix);
-      return;
-    }
-  s.fixes.push_back(std::move(fix));
+  auto same_id = std::find_if(s.fixes.begin(), s.fixes.end(),
+                              [&](const auto& f) { return f->id() == a[0]; });
+  if (same_id != s.fixes.end()) {
+    // LAMMPS semantics: a fix with an existing ID replaces it in place, if of the same style.
+    const std::string& old_style = (*same_id)->style();
+    if (old_style != a[2])
+      throw EngineError("fix " + a[0] + " exists with style " + old_style +
+                        "; replacing a fix by one of another style (" + a[2] +
+                        ") is an error in LIGGGHTS 3.8: unfix it first");
+    if (old_style == "wall/gran")
+      throw EngineError("fix " + a[0] + " (wall/gran) is defined again without unfix, which "
+                        "LIGGGHTS 3.8 does not support (it crashes): unfix it first");
+    // The old fix's properties go first: the new one registers its own under the same ID.
+    s.properties.remove_owned_by(a[0]);
+    *same_id = it->second(s, command);
+    return;
+  }
+  s.fixes.push_back(it->second(s, command));
 }
 
 void cmd_unfix(Simulation& s, const std::vector<std::string>& a) {
@@ -306,13 +318,26 @@ void Simulation::execute(const Command& command) {
          expect_exact(x, {"single", "vel", "yes"}, "communicate");
        }},
       {"processors",
+       // The MPI domain decomposition; this engine runs the same model in one process.
        [](Simulation&, const std::vector<std::string>& x) {
          if (x.size() < 3) throw EngineError("usage: processors Px Py Pz");
+         for (int k = 0; k < 3; ++k)
+           if (x[k] != "*" && parse_int(x[k], "processors count") < 1)
+             throw EngineError("processors counts must be * or >= 1");
+         if (x.size() > 3)
+           throw EngineError("processors keyword '" + x[3] + "' is not supported by this engine");
        }},
       {"soft_particles",
        [](Simulation& s, const std::vector<std::string>& x) {
-         require_args(x, 1, "soft_particles yes|no");
-         s.soft_particles = parse_yes_no(x[0], "soft_particles");
+         if (x.size() != 1 || (x[0] != "yes" && x[0] != "no"))
+           throw EngineError("soft_particles expects 'yes' or 'no'");
+         s.soft_particles = x[0] == "yes";
+       }},
+      {"hard_particles",
+       [](Simulation& s, const std::vector<std::string>& x) {
+         if (x.size() != 1 || (x[0] != "yes" && x[0] != "no"))
+           throw EngineError("hard_particles expects 'yes' or 'no'");
+         s.hard_particles = x[0] == "yes";
        }},
       {"boundary", cmd_boundary},
       {"region",

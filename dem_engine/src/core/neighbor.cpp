@@ -76,6 +76,28 @@ std::vector<std::size_t> spatial_order(const Particles& p, double cell) {
   return order;
 }
 
+void NeighborList::retag(const std::vector<std::pair<std::int64_t, std::int64_t>>& old_to_new) {
+  std::vector<char> changed(tags_at_build_.size(), 1);
+  for (std::size_t i = 0; i < tags_at_build_.size(); ++i) {
+    std::int64_t& t = tags_at_build_[i];
+    const auto it = std::lower_bound(
+        old_to_new.begin(), old_to_new.end(), t,
+        [](const std::pair<std::int64_t, std::int64_t>& e, std::int64_t v) { return e.first < v; });
+    const bool found = it != old_to_new.end() && it->first == t;
+    changed[i] = !found || it->second != t;
+    t = found ? it->second : 0;  // 0: no particle
+  }
+  // LIGGGHTS finds the history of a pair again through the id one particle recorded for the
+  // other, so it survives when at least one of the two ids is unchanged.
+  for (std::size_t i = 0; i + 1 < first.size() && i < changed.size(); ++i)
+    for (int k = first[i]; k < first[i + 1]; ++k)
+      if (changed[i] && changed[static_cast<std::size_t>(partner[k])]) {
+        touching[static_cast<std::size_t>(k)] = 0;
+        std::fill_n(&history[static_cast<std::size_t>(k) * kHistorySize], kHistorySize, 0.0);
+      }
+  forced_ = true;
+}
+
 void NeighborList::build(const Particles& p, const Domain& domain) {
   const std::size_t n = p.size();
   // Contact history transfer: when the particle order is unchanged since the last build, the
@@ -85,6 +107,9 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   std::vector<OldContact> old;
   std::vector<int> old_first, old_partner;
   std::vector<double> old_history;
+  // Only pairs that touched at their last evaluation keep their history.
+  for (std::size_t k = 0; k < touching.size(); ++k)
+    if (!touching[k]) std::fill_n(&history[k * kHistorySize], kHistorySize, 0.0);
   if (same_order) {
     old_first.swap(first);
     old_partner.swap(partner);

@@ -10,7 +10,9 @@
 namespace dem {
 
 // Half neighbour list (each pair once, i < j) from cell binning with a skin. Contact history
-// lives beside the list and survives rebuilds, matched by particle tags.
+// lives beside the list and survives rebuilds, matched by particle tags, for the pairs that
+// touched at their last evaluation; the history of a pair that opened is kept until the next
+// build and dropped there (LIGGGHTS semantics).
 // Order of the particles along a cell grid (cells of size `cell`, x fastest), so that
 // neighbours in space are neighbours in memory.
 std::vector<std::size_t> spatial_order(const Particles& p, double cell);
@@ -25,8 +27,8 @@ class NeighborList {
   std::vector<int> first;         // size n+1: pairs of i are [first[i], first[i+1])
   std::vector<int> partner;       // j for every pair
   std::vector<double> history;    // kHistorySize doubles per pair
-  // Per pair: 1 while its history may be non-zero (the pair touched at its last evaluation);
-  // 0 guarantees a zero history, so pairs apart need not read it.
+  // Per pair: 1 when the pair touched at its last evaluation (set at a build for the pairs
+  // whose history was carried over). Only such histories are carried over by a build.
   std::vector<std::uint8_t> touching;
 
   // True when every rebuild check is done at every step, so that no particle moves more than
@@ -36,6 +38,10 @@ class NeighborList {
   // True when a rebuild is due at this step (displacement beyond skin/2, or forced).
   bool due(const Particles& p, long steps_since_build) const;
   void force_rebuild() { forced_ = true; }
+  // The particles were given new tags: (old, new) pairs sorted by the old tag. Histories are
+  // matched through the new tags at the next build; tags not listed match no pair any more, and
+  // the histories of pairs whose two tags both changed are dropped (as LIGGGHTS loses them).
+  void retag(const std::vector<std::pair<std::int64_t, std::int64_t>>& old_to_new);
   // Rebuilds the list; `extra_cutoff` widens the search (largest radius to be inserted).
   void build(const Particles& p, const Domain& domain);
   long builds() const { return builds_; }

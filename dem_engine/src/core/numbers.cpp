@@ -33,9 +33,11 @@ long parse_int(const std::string& text, const std::string& what) {
 }
 
 bool parse_yes_no(const std::string& text, const std::string& what) {
-  if (text == "yes" || text == "on") return true;
-  if (text == "no" || text == "off") return false;
-  throw EngineError("expected yes/no for " + what + ", got '" + text + "'");
+  // LIGGGHTS refuses on/off for these keywords (the contact model keywords, which take on/off,
+  // are parsed elsewhere).
+  if (text == "yes") return true;
+  if (text == "no") return false;
+  throw EngineError("expected yes or no for " + what + ", got '" + text + "'");
 }
 
 void require_args(const std::vector<std::string>& args, std::size_t n, const std::string& usage) {

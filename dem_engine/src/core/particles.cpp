@@ -92,6 +92,19 @@ void Particles::set_density(std::size_t i, double rho) {
   rmass[i] = sphere_mass(radius[i], rho);
 }
 
+std::vector<std::pair<std::int64_t, std::int64_t>> Particles::renumber_tags() {
+  std::vector<std::size_t> order(size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return tag[a] < tag[b]; });
+  std::vector<std::pair<std::int64_t, std::int64_t>> map(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    map[k] = {tag[order[k]], static_cast<std::int64_t>(k + 1)};
+    tag[order[k]] = static_cast<std::int64_t>(k + 1);
+  }
+  max_tag_ = static_cast<std::int64_t>(order.size());
+  return map;
+}
+
 long Particles::index_of(std::int64_t id) const {
   for (std::size_t i = 0; i < tag.size(); ++i)
     if (tag[i] == id) return static_cast<long>(i);

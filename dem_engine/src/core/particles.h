@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "core/vec3.h"
@@ -30,6 +31,9 @@ class Particles {
   void permute(const std::vector<std::size_t>& order);
   void set_radius(std::size_t i, double r);    // keeps density, updates mass
   void set_density(std::size_t i, double rho);  // keeps radius, updates mass
+  // Gives the particles the tags 1..N in the order of their current tags (delete_atoms
+  // compress yes); returns (old tag, new tag) pairs sorted by the old tag.
+  std::vector<std::pair<std::int64_t, std::int64_t>> renumber_tags();
   std::int64_t next_tag() noexcept { return ++max_tag_; }
   std::int64_t max_tag() const noexcept { return max_tag_; }
   // Local index of a tag, or -1.

@@ -71,7 +71,14 @@ void Simulation::compute_forces() {
       thread_force_[t].resize(n);
       thread_torque_[t].resize(n);
     }
-    PairForceArgs args{atoms, neighbor, material, domain, dt, thread_force_, thread_torque_};
+    std::uint32_t freeze_bit = 0;
+    for (const auto& f : fixes)
+      if (f->style() == "freeze") {
+        freeze_bit = f->group_bit();
+        break;
+      }
+    PairForceArgs args{atoms,        neighbor,   material,      domain,        dt,
+                       !setting_up_, freeze_bit, thread_force_, thread_torque_};
     pair->pair_forces(args);
     // Blow-up guard: an overlap of half the smaller radius is never physical here.
     if (args.max_overlap_ratio > 0.5) {
@@ -179,7 +186,7 @@ void Simulation::check_timestep() {
 void Simulation::setup_run() {
   if (!domain.defined) throw EngineError("run before create_box");
   if (!pair) throw EngineError("run before pair_style gran");
-  material.build(properties, ntypes, soft_particles, pair->spec().rolling_epsd2,
+  material.build(properties, ntypes, soft_particles, hard_particles, pair->spec().rolling_epsd2,
                  pair->spec().cohesion_sjkr);
   for (auto& f : fixes) f->init();
   handle_lost_particles();
@@ -188,8 +195,10 @@ void Simulation::setup_run() {
   neighbor.force_rebuild();
   neighbor.build(atoms, domain);
   last_build_step_ = step;
+  setting_up_ = true;
   compute_forces();
   for (auto& f : fixes) f->setup();
+  setting_up_ = false;
 }
 
 void Simulation::integrate_step() {
@@ -218,6 +227,7 @@ void Simulation::run(const Command& command) {
   long n = parse_int(a[0], "run N");
   std::size_t k = 1;
   long every = 0;
+  bool pre = true;
   std::vector<std::string> every_commands;
   while (k < a.size()) {
     if (a[k] == "upto") {
@@ -231,21 +241,41 @@ void Simulation::run(const Command& command) {
       if (every_commands.size() == 1 && every_commands[0] == "NULL") every_commands.clear();
       k = a.size();
     } else if ((a[k] == "pre" || a[k] == "post") && k + 1 < a.size()) {
-      parse_yes_no(a[k + 1], a[k]);
+      // LAMMPS run keywords take yes or no only. `post` selects the length of the timing
+      // summary, which this engine does not print.
+      if (a[k + 1] != "yes" && a[k + 1] != "no")
+        throw EngineError("'" + a[k] + "' expects yes or no, got '" + a[k + 1] + "'");
+      if (a[k] == "pre") pre = a[k + 1] == "yes";
       k += 2;
     } else {
       throw EngineError("unknown run keyword '" + a[k] + "'");
     }
   }
   if (n < 0) throw EngineError("run length is negative");
+  // LIGGGHTS refuses more than 2^31-1 steps in one run ("Invalid run command N size").
+  if (n > 2147483647L) throw EngineError("run length " + std::to_string(n) + " exceeds 2147483647");
   // `run N every M cmds`: N/M chained runs of M steps with the commands after each.
   const long chunk = every > 0 ? every : n;
   long remaining = n;
+  // `pre no` after an earlier run (with `every`: for the chunks after the first): LIGGGHTS
+  // neither initialises nor sets up (no neighbour build, no step-0 forces; the forces of the
+  // last step carry over). That is exact only when nothing the set-up would take into account
+  // has changed, so other cases are refused.
+  bool skip_setup = !pre && has_run_ && every == 0;
+  if (skip_setup) {
+    std::vector<const Fix*> now;
+    for (const auto& f : fixes) now.push_back(f.get());
+    if (changed_since_run_ || now != fixes_at_run_)
+      throw EngineError(
+          "'pre no' after particles or fixes changed since the last run (LIGGGHTS would run "
+          "without setting them up); use 'pre yes'");
+  }
   do {
     const long this_run = std::min(chunk, remaining);
     run_start_step = step;
     run_end_step = step + this_run;
-    setup_run();
+    if (!skip_setup) setup_run();
+    skip_setup = !pre;
     thermo.header(*this);
     thermo.row(*this);
     for (auto& d : dumps) d->write();
@@ -271,8 +301,21 @@ void Simulation::run(const Command& command) {
          << " particle-steps/s, " << neighbor.builds() << " neighbour builds)";
     message(os.str());
     remaining -= this_run;
+    has_run_ = true;
+    changed_since_run_ = false;
+    fixes_at_run_.clear();
+    for (const auto& f : fixes) fixes_at_run_.push_back(f.get());
     if (every > 0)
       for (const auto& c : every_commands) input().run_line(c, command.where);
+    // The commands run between chunks may change the system, which `pre no` would not set up.
+    if (skip_setup) {
+      std::vector<const Fix*> now;
+      for (const auto& f : fixes) now.push_back(f.get());
+      if (changed_since_run_ || now != fixes_at_run_)
+        throw EngineError(
+            "'pre no' with 'every' commands that change particles or fixes (LIGGGHTS would run "
+            "without setting them up); use 'pre yes'");
+    }
   } while (remaining > 0);
 }
 

@@ -69,7 +69,10 @@ Compute& Simulation::compute(const std::string& id) const {
   throw EngineError("unknown compute '" + id + "'");
 }
 
-void Simulation::particles_changed() { neighbor.force_rebuild(); }
+void Simulation::particles_changed() {
+  neighbor.force_rebuild();
+  changed_since_run_ = true;
+}
 
 double Simulation::max_radius() const {
   double r = 0.0;
@@ -95,12 +98,16 @@ void Simulation::wall_contact(std::size_t i, const Vec3& normal, double overlap,
   c.rj = 0.0;
   c.r_eff = c.ri;
   c.m_eff = atoms.rmass[i];
-  c.cri = dist;  // the contact point lies on the wall
+  c.cri = c.ri - 0.5 * overlap;  // as for particle pairs (LIGGGHTS)
   c.crj = 0.0;
   c.v_rel = atoms.v[i] - wall_velocity;
   c.omega_i = atoms.omega[i];
   c.omega_j = Vec3{};
-  pair_model().evaluate(c, material.get(atoms.type[i], wall_type), dt, history, result);
+  ContactStep step;
+  step.options = pair_model().spec().options;
+  step.dt = dt;
+  step.update_history = !setting_up_;
+  pair_model().evaluate(c, material.get(atoms.type[i], wall_type), step, history, result);
 }
 
 double Simulation::kinetic_energy(std::uint32_t bit) const {

@@ -58,7 +58,8 @@ class Simulation : public CommandHandler, public EvalContext {
   double dt = 1e-5;             // timestep (s)
   long step = 0;                // current step
   double time = 0.0;            // simulated time (s)
-  bool soft_particles = false;
+  bool soft_particles = false;  // allows youngsModulus < 5e6 Pa
+  bool hard_particles = false;  // allows youngsModulus > 1e9 Pa
   long run_start_step = 0, run_end_step = 0;  // of the current run
 
   // --- services for fixes, computes and dumps -----------------------------------------------
@@ -81,6 +82,8 @@ class Simulation : public CommandHandler, public EvalContext {
                     const Vec3& wall_velocity, int wall_type, double* history,
                     ContactResult& result) const;
   const ContactModel& pair_model() const;  // throws if no pair_style
+  // True while a run computes its initial forces: contact histories are used, not advanced.
+  bool setting_up() const { return setting_up_; }
 
   // --- deck interface -------------------------------------------------------------------------
   void run_deck(const std::string& path, const std::vector<std::pair<std::string,
@@ -115,6 +118,13 @@ class Simulation : public CommandHandler, public EvalContext {
   long last_build_step_ = 0;
   std::vector<std::vector<Vec3>> thread_force_, thread_torque_;
   bool timestep_checked_ = false;
+  bool setting_up_ = false;
+  // `run ... pre no` skips the set-up only after an earlier run and when no particles were
+  // added, removed or changed and no fix was defined or removed since (as in LIGGGHTS, the
+  // forces of the last step carry over); see Simulation::run.
+  bool has_run_ = false;
+  bool changed_since_run_ = false;
+  std::vector<const Fix*> fixes_at_run_;
 };
 
 }  // namespace dem

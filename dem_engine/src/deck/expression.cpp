@@ -110,7 +110,11 @@ class Parser {
 
  private:
   [[noreturn]] void fail(const std::string& reason) const {
-    throw EngineError(reason + " in formula '" + text_ + "'");
+    // Long formulas are cut so that the error stays one readable line.
+    constexpr std::size_t kShown = 200;
+    const std::string shown =
+        text_.size() > kShown ? text_.substr(0, kShown) + "..." : text_;
+    throw EngineError(reason + " in formula '" + shown + "'");
   }
 
   bool at_end() const { return pos_ >= text_.size(); }

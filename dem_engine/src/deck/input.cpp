@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <new>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -432,6 +433,8 @@ void Input::execute_line(const std::string& line, const SourceLocation& where) {
     dispatch(command, first_arg_quoted);
   } catch (const DeckError&) {
     throw;  // already located, e.g. inside an include file
+  } catch (const std::bad_alloc&) {
+    throw DeckError(where, name, "out of memory (is a count or size in this command too large?)");
   } catch (const std::exception& e) {
     throw DeckError(where, name, e.what());
   } catch (...) {

@@ -23,6 +23,7 @@ DiscreteDistribution::DiscreteDistribution(std::vector<SphereTemplate> templates
     if (!(weights[k] > 0.0))
       throw EngineError("weight of template " + templates_[k].id + " must be > 0");
   const double sum = std::accumulate(weights.begin(), weights.end(), 0.0);
+  if (!std::isfinite(sum)) throw EngineError("the weights must sum to a finite number");
   renormalised_ = std::fabs(sum - 1.0) > 1e-10;
   for (double& w : weights) w /= sum;
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <optional>
+#include <sstream>
 
 #include "core/numbers.h"
 #include "core/region.h"
@@ -121,7 +122,8 @@ void InsertFix::parse_arguments() {
     } else if (key == "ntry_mc") {
       need(i, 1);
       ntry_mc_ = parse_int(a[i + 1], "ntry_mc");
-      if (ntry_mc_ < 1000) throw EngineError("ntry_mc must be >= 1000");
+      if (ntry_mc_ < 1000 || ntry_mc_ > 1000000000)
+        throw EngineError("ntry_mc must be in 1000..1000000000");
       i += 2;
     } else if (key == "orientation" || key == "set_property" || key == "duration" ||
                key == "extrude_length") {
@@ -308,6 +310,25 @@ long InsertFix::insert(long n, bool exact) {
   return inserted;
 }
 
+long InsertFix::checked_count(double n) const {
+  if (std::isnan(n)) throw EngineError("fix " + id() + ": the number to insert is not a number");
+  if (!(n >= 1.0)) return 0;
+  // A sphere fills at least its own volume: more of the smallest template than fit into the
+  // region volume cannot be placed (and would only allocate memory).
+  const DiscreteDistribution& dist = distribution();
+  double smallest = dist.at(0).volume();
+  for (std::size_t k = 1; k < dist.size(); ++k) smallest = std::min(smallest, dist.at(k).volume());
+  const double capacity = region_volume_ / smallest;
+  if (!(n <= capacity)) {
+    std::ostringstream os;
+    os << "fix " << id() << ": " << n << " particles per insertion cannot fit into region '"
+       << region_id_ << "' (volume " << region_volume_ << " m^3 holds at most " << capacity
+       << " spheres of " << smallest << " m^3)";
+    throw EngineError(os.str());
+  }
+  return static_cast<long>(n);
+}
+
 void InsertFix::pre_exchange() {
   if (next_step_ < 0 || sim_.step != next_step_) return;
   const long n = count_this_event();
@@ -381,7 +402,7 @@ long InsertPackFix::count_this_event() {
     n = static_cast<double>(particles_target_ - n_in);
   else
     n = std::floor((mass_target_ - mass_in) / dist.mass_expect() + random_.uniform());
-  return n > 0.0 ? static_cast<long>(n) : 0;
+  return checked_count(n);
 }
 
 // --- insert/rate/region --------------------------------------------------------------------
@@ -426,15 +447,21 @@ std::size_t InsertRateRegionFix::parse_style_keyword(std::size_t i) {
 
 void InsertRateRegionFix::prepare() {
   const DiscreteDistribution& dist = distribution();
-  if (mass_total_ > 0.0) total_ = static_cast<long>(mass_total_ / dist.mass_expect());
-  else if (mass_total_ == -1.0) total_ = -1;
+  if (mass_total_ > 0.0) {
+    // A total beyond any count the run can reach is as good as INF.
+    const double total = mass_total_ / dist.mass_expect();
+    total_ = total < 4e18 ? static_cast<long>(total) : -1;
+  } else if (mass_total_ == -1.0) {
+    total_ = -1;
+  }
   if (!(particle_rate_ > 0.0)) particle_rate_ = mass_rate_ / dist.mass_expect();
   // Fixed at the first run, as in LIGGGHTS: later dt changes do not alter the feed per event.
   per_event_ = particle_rate_ * static_cast<double>(insert_every_) * sim_.dt;
+  checked_count(per_event_);
 }
 
 long InsertRateRegionFix::count_this_event() {
-  auto n = static_cast<long>(std::floor(per_event_ + random_.uniform()));
+  auto n = checked_count(std::floor(per_event_ + random_.uniform()));
   if (total_ >= 0) n = std::min(n, total_ - ninserted_);
   return std::max(n, 0L);
 }

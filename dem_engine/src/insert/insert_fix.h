@@ -43,6 +43,9 @@ class InsertFix : public Fix {
   // Volume of the insertion region within the box (m^3): analytic when the region lies inside
   // the box, otherwise a Monte Carlo estimate with ntry_mc samples.
   double region_volume() const { return region_volume_; }
+  // n as a particle count (0 below 1); throws EngineError for NaN or more spheres of the
+  // smallest template than the region volume holds.
+  long checked_count(double n) const;
   // True when the particle at local index i counts as inside the region (centre, or the whole
   // sphere with all_in yes).
   bool counts_in_region(std::size_t i) const;

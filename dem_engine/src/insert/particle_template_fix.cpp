@@ -76,6 +76,15 @@ ParticleTemplateFix::ParticleTemplateFix(Simulation& sim, const Command& command
        << " m^3 (set a smaller volume_limit if this radius is intended)";
     throw EngineError(os.str());
   }
+  // Mass and moment of inertia must be finite numbers for the integrator.
+  const double mass = sphere_.mass();
+  if (!std::isfinite(sphere_.volume()) || !std::isfinite(mass) ||
+      !std::isfinite(mass * sphere_.radius * sphere_.radius)) {
+    std::ostringstream os;
+    os << "radius " << sphere_.radius << " m and density " << sphere_.density
+       << " kg/m^3 give a particle mass or moment of inertia that is not a finite number";
+    throw EngineError(os.str());
+  }
 }
 
 ParticleDistributionFix::ParticleDistributionFix(Simulation& sim, const Command& command)

@@ -12,7 +12,6 @@ namespace dem {
 namespace {
 
 constexpr double kDegree = M_PI / 180.0;
-constexpr double kDefaultCurvatureDeg = 0.256235;  // LIGGGHTS default
 
 bool is_unsupported_mesh_keyword(const std::string& w) {
   return w == "precision" || w == "heal" || w == "region" || w == "min_feature_length" ||
@@ -85,19 +84,20 @@ FixMeshSurface::FixMeshSurface(Simulation& sim, const Command& command) : Fix(si
     }
   }
   // Surface keywords.
-  double curvature_deg = kDefaultCurvatureDeg;
+  double curvature_deg = kDefaultCurvatureDegrees;
   for (bool more = true; more && p < a.size();) {
     more = false;
     if (a[p] == "curvature") {
       need(1, "curvature");
       curvature_deg = parse_double(a[p + 1], "curvature");
-      if (!(curvature_deg > 0.0 && curvature_deg < 90.0))
-        throw EngineError("0 < curvature < 90 degrees required, got " + a[p + 1]);
+      if (!(curvature_deg > 0.0 && curvature_deg < 60.0))
+        throw EngineError("0 < curvature < 60 degrees required, got " + a[p + 1]);
       p += 2;
       more = true;
     }
   }
-  cos_curvature_ = std::cos(curvature_deg * kDegree);
+  // After scale, move and rotate: nodes are merged at the final size.
+  mesh_.set_curvature(curvature_deg, "STL file '" + path + "'");
   pos_ = p;
   reject_rest("mesh/surface");
   sim.message("Import of mesh " + id() + " containing " + std::to_string(mesh_.size()) +
@@ -125,6 +125,8 @@ void FixMeshSurface::reject_rest(const std::string& exact_style) const {
 }
 
 void FixMeshSurface::init() {
+  // The forces at the set-up of a run see the wall at rest, as in LIGGGHTS: node velocities
+  // are set again by the motions of the first step.
   mesh_.clear_velocities();
   used_by_wall_ = false;
   force_ = torque_ = Vec3{};
@@ -304,7 +306,6 @@ void FixMeshSurfaceStressServo::init() {
       throw EngineError("target_val: variable '" + name + "' is not equal-style");
   }
   if (!integrate_) speed_ = 0.0;
-  mesh_.add_velocity(speed_ * axis_);
 }
 
 void FixMeshSurfaceStressServo::setup() {

@@ -12,9 +12,11 @@ namespace dem {
 //     [rotate axis AX AY AZ angle DEG] [curvature DEG]
 // An STL wall of material type T. scale/move/rotate are applied in the order given, about the
 // origin (LIGGGHTS). Keywords come in LIGGGHTS' groups (file, pre-mesh, mesh, surface, ...);
-// a keyword out of its group is an error, as in LIGGGHTS. `curvature` is the largest angle
-// between contact normals for which a tangential contact history moves from one triangle to
-// the next (default 0.256235 deg). The group is ignored.
+// a keyword out of its group is an error, as in LIGGGHTS. `curvature` (0 to 60 degrees, at most
+// the smallest angle of a triangle; default 0.256235) is the largest angle between the normals
+// of two triangles sharing an edge for which they count as one surface: their shared edge
+// makes no contact, a sphere touching both gets one contact, and its contact history moves
+// from one to the other (see MeshTopology and find_mesh_contacts). The group is ignored.
 class FixMeshSurface : public Fix {
  public:
   FixMeshSurface(Simulation& sim, const Command& command);
@@ -22,7 +24,6 @@ class FixMeshSurface : public Fix {
   TriMesh& mesh() { return mesh_; }
   const TriMesh& mesh() const { return mesh_; }
   int wall_type() const { return wall_type_; }
-  double cos_curvature() const { return cos_curvature_; }
 
   // Force and torque the particles exert on the mesh, summed by the walls that use it.
   virtual bool tracks_stress() const { return false; }
@@ -56,7 +57,6 @@ class FixMeshSurface : public Fix {
  private:
   std::size_t pos_ = 0;
   int wall_type_ = 0;
-  double cos_curvature_ = 0.0;
 };
 
 // fix ID group mesh/surface/stress ... [stress on|off] [reference_point X Y Z] [wear off]

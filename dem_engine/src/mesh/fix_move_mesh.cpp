@@ -93,7 +93,6 @@ void FixMoveMesh::init() {
   FixMeshSurface* now = find_mesh_fix(sim_, mesh_id_);
   if (now != mesh_fix_)
     throw EngineError("move/mesh: mesh fix '" + mesh_id_ + "' was redefined after fix " + id());
-  add_velocity();
 }
 
 void FixMoveMesh::initial_integrate() {

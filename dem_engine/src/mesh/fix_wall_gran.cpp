@@ -18,7 +18,8 @@ namespace {
 bool same_spec(const ModelSpec& a, const ModelSpec& b) {
   return a.cohesion_sjkr == b.cohesion_sjkr && a.rolling_epsd2 == b.rolling_epsd2 &&
          a.options.limit_force == b.options.limit_force &&
-         a.options.tangential_damping == b.options.tangential_damping;
+         a.options.tangential_damping == b.options.tangential_damping &&
+         a.options.tangential_reduce == b.options.tangential_reduce;
 }
 
 std::string describe(const ModelSpec& s) {
@@ -27,6 +28,7 @@ std::string describe(const ModelSpec& s) {
   if (s.rolling_epsd2) text += " rolling_friction epsd2";
   if (s.options.limit_force) text += " limitForce on";
   if (!s.options.tangential_damping) text += " tangential_damping off";
+  if (s.options.tangential_reduce) text += " tangential_reduce on";
   return text;
 }
 
@@ -42,8 +44,7 @@ constexpr std::size_t kParallelMin = 4096;
 
 FixWallGran::FixWallGran(Simulation& sim, const Command& command) : Fix(sim, command) {
   const auto& a = args();
-  std::size_t p = parse_model_spec(a, 0, spec_, true);
-  check_model();
+  std::size_t p = parse_model_types(a, 0, spec_);
   if (p >= a.size()) throw EngineError("expected 'primitive' or 'mesh' after the model");
   if (a[p] == "primitive") {
     ++p;
@@ -84,11 +85,13 @@ FixWallGran::FixWallGran(Simulation& sim, const Command& command) : Fix(sim, com
   } else {
     throw EngineError("expected 'primitive' or 'mesh', got '" + a[p] + "'");
   }
-  if (p < a.size())
-    throw EngineError("unexpected '" + a[p] +
-                      "' after the wall definition (model keywords go before 'primitive' or "
-                      "'mesh'; wall keywords such as shear or store_force are not supported by "
-                      "this engine)");
+  // Model keywords (limitForce, ...) follow the wall definition, as in LIGGGHTS.
+  while (p < a.size())
+    if (!parse_model_keyword(a, p, spec_))
+      throw EngineError("unexpected '" + a[p] +
+                        "' after the wall definition (wall keywords such as shear or "
+                        "store_force are not supported by this engine)");
+  check_model();
 }
 
 void FixWallGran::check_model() const {
@@ -96,6 +99,21 @@ void FixWallGran::check_model() const {
   if (!same_spec(pair.spec(), spec_))
     throw EngineError("the wall model '" + describe(spec_) +
                       "' differs from the pair style's '" + describe(pair.spec()) + "'");
+}
+
+void FixWallGran::check_single_mesh_wall() const {
+  // LIGGGHTS 3.8 runs with at most one mesh wall/gran fix (it lists every mesh); the check is
+  // made at run, as there, so that a deck may replace the fix (unfix, then fix again) before.
+  for (const auto& f : sim_.fixes) {
+    const auto* other = dynamic_cast<const FixWallGran*>(f.get());
+    if (other == nullptr || other == this || !other->mesh_mode()) continue;
+    const SourceLocation& w = other->where();
+    throw DeckError(w, "fix",
+                    "fix " + other->id() + " is a second fix wall/gran with meshes at run (fix " +
+                        id() + " at " + where().file + ":" + std::to_string(where().line) +
+                        " is the first); LIGGGHTS 3.8 runs with one: list every mesh in a single "
+                        "fix (mesh n_meshes N meshes ID1 ... IDN), or unfix the other first");
+  }
 }
 
 void FixWallGran::init() {
@@ -106,6 +124,7 @@ void FixWallGran::init() {
                         "plane wall needs a non-periodic boundary in that dimension");
     return;
   }
+  check_single_mesh_wall();
   mesh_fixes_.clear();
   meshes_.clear();
   for (const std::string& mid : mesh_ids_) {
@@ -119,8 +138,6 @@ void FixWallGran::init() {
   list_.force_rebuild();
   stress_bits_.assign(meshes_.size(), 0);
   reference_.assign(meshes_.size(), Vec3{});
-  cos_curvature_.clear();
-  for (const FixMeshSurface* mf : mesh_fixes_) cos_curvature_.push_back(mf->cos_curvature());
   const int nthreads = std::max(1, omp_get_max_threads());
   scratch_.resize(nthreads);
   for (Scratch& s : scratch_) {
@@ -246,7 +263,7 @@ void FixWallGran::mesh_forces() {
         continue;
       }
       if (s.contacts.size() > kMaxContacts) s.contacts.resize(kMaxContacts);
-      overflow += assign_history_slots(slots, s.contacts, cos_curvature_, s.history,
+      overflow += assign_history_slots(slots, s.contacts, meshes_, s.history,
                                        s.overflow.data());
       for (std::size_t k = 0; k < s.contacts.size(); ++k) {
         const MeshContact& c = s.contacts[k];

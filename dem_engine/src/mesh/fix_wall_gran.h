@@ -12,9 +12,9 @@
 namespace dem {
 
 // fix ID group wall/gran model hertz tangential history [cohesion sjkr] [rolling_friction epsd2]
-//     [model keywords] primitive type T xplane|yplane|zplane C
-// fix ID group wall/gran ... primitive type T xcylinder|ycylinder|zcylinder R C1 C2
-// fix ID group wall/gran ... mesh n_meshes N meshes ID1 ... IDN
+//     primitive type T xplane|yplane|zplane C [model keywords]
+// fix ID group wall/gran ... primitive type T xcylinder|ycylinder|zcylinder R C1 C2 [...]
+// fix ID group wall/gran ... mesh n_meshes N meshes ID1 ... IDN [...]
 // Granular walls with the contact law of pair_style gran (the model words must match it).
 // Particles of the group interact with the wall from the side their centre is on; forces and
 // torques are added in post_force. One contact history per particle and contact (primitive:
@@ -29,9 +29,11 @@ class FixWallGran : public Fix {
   void post_force() override;
 
   const TriangleNeighborList& triangle_list() const { return list_; }
+  bool mesh_mode() const { return mesh_mode_; }
 
  private:
   void check_model() const;
+  void check_single_mesh_wall() const;
   void primitive_forces();
   void find_near_primitive();
   void mesh_forces();
@@ -54,7 +56,6 @@ class FixWallGran : public Fix {
   TriangleNeighborList list_;
   std::vector<std::uint32_t> stress_bits_;  // per mesh: group bit if it tracks stress, else 0
   std::vector<Vec3> reference_;             // per mesh: torque reference point
-  std::vector<double> cos_curvature_;       // per mesh
   std::size_t history_ = 0;                 // Particles extra handle
   bool overflow_warned_ = false;
 

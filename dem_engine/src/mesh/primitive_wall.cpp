@@ -45,7 +45,7 @@ bool PrimitiveWall::contact(const Vec3& x, double reach, Vec3& normal, double& d
     normal[dim] = d >= 0.0 ? 1.0 : -1.0;
     return true;
   }
-  const int d1 = dim == 0 ? 1 : 0, d2 = dim == 2 ? 1 : 2;
+  const int d1 = (dim + 1) % 3, d2 = (dim + 2) % 3;  // cyclic: (y, z), (z, x), (x, y)
   const double u = x[d1] - c1, v = x[d2] - c2;
   const double rho = std::sqrt(u * u + v * v);
   dist = std::fabs(radius - rho);

@@ -8,7 +8,8 @@ namespace dem {
 
 // Geometry of the primitive walls of fix wall/gran: a plane normal to x, y or z at `position`,
 // or an infinite cylinder along x, y or z of `radius` whose axis passes through (c1, c2) in the
-// other two dimensions (in x, y, z order: xcylinder (y, z), ycylinder (x, z), zcylinder (x, y)).
+// other two dimensions, in cyclic order as LIGGGHTS 3.8 reads them: xcylinder (y, z),
+// ycylinder (z, x), zcylinder (x, y).
 // Walls act from the side the particle centre is on.
 struct PrimitiveWall {
   enum class Kind { kPlane, kCylinder };

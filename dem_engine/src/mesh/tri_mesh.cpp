@@ -23,6 +23,21 @@ TriMesh::TriMesh(const std::vector<Triangle>& triangles, const std::string& sour
   }
   velocities_.assign(nodes_.size(), Vec3{});
   reject_duplicates(source);
+  set_curvature(kDefaultCurvatureDegrees, source);
+}
+
+void TriMesh::set_curvature(double degrees, const std::string& source) {
+  for (std::size_t t = 0; t < size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 u = node(t, (k + 1) % 3) - node(t, k), w = node(t, (k + 2) % 3) - node(t, k);
+      const double angle = std::acos(std::clamp(dot(u, w) / (norm(u) * norm(w)), -1.0, 1.0));
+      if (degrees * M_PI / 180.0 > angle)
+        throw EngineError("mesh from " + source + ": the curvature " + std::to_string(degrees) +
+                          " degrees exceeds the angle of " +
+                          std::to_string(angle * 180.0 / M_PI) + " degrees of triangle " +
+                          std::to_string(t + 1) + " (LIGGGHTS refuses this)");
+    }
+  topology_ = MeshTopology(nodes_, std::cos(degrees * M_PI / 180.0));
 }
 
 void TriMesh::reject_duplicates(const std::string& source) const {

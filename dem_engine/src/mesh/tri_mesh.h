@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/vec3.h"
+#include "mesh/mesh_topology.h"
 #include "mesh/stl_io.h"
 #include "mesh/triangle_geometry.h"
 
@@ -12,6 +13,9 @@ namespace dem {
 // A rigid triangle surface mesh: three nodes per triangle (no shared node table, the STL
 // "triangle soup"), a velocity per node for moving walls, and reference frames that move with
 // the mesh (the origins and axes of superposed motions).
+// LIGGGHTS' default curvature of fix mesh/surface (degrees).
+constexpr double kDefaultCurvatureDegrees = 0.256235;
+
 class TriMesh {
  public:
   TriMesh() = default;
@@ -27,6 +31,11 @@ class TriMesh {
   ClosestPoint closest_point(std::size_t tri, const Vec3& p) const {
     return closest_point_on_triangle(p, nodes_[3 * tri], nodes_[3 * tri + 1], nodes_[3 * tri + 2]);
   }
+  // Contact point of a sphere centred at p with triangle `tri`, as LIGGGHTS finds it.
+  ClosestPoint contact_point(std::size_t tri, const Vec3& p) const {
+    return contact_point_on_triangle(p, nodes_[3 * tri], nodes_[3 * tri + 1], nodes_[3 * tri + 2],
+                                     topology_.face_tolerance(tri));
+  }
   // Velocity of the surface at a point given by barycentric weights (m/s). Exact for rigid
   // motions, whose velocity field is affine in the position.
   Vec3 velocity_at(std::size_t tri, const ClosestPoint& cp) const {
@@ -34,6 +43,13 @@ class TriMesh {
     return cp.wa * v[0] + cp.wb * v[1] + cp.wc * v[2];
   }
   bool moving() const { return moving_; }
+
+  // Active edges and corners and coplanar neighbours for the curvature angle (degrees), see
+  // MeshTopology; the constructor uses LIGGGHTS' default of 0.256235 degrees. Throws
+  // EngineError naming `source` when the curvature exceeds an angle of a triangle (LIGGGHTS
+  // refuses such meshes).
+  void set_curvature(double degrees, const std::string& source);
+  const MeshTopology& topology() const { return topology_; }
 
   // Set-up transformations (mesh/surface keywords): about the origin, as LIGGGHTS does.
   void scale(double factor);
@@ -63,6 +79,7 @@ class TriMesh {
   std::vector<Vec3> nodes_;
   std::vector<Vec3> velocities_;
   std::vector<Frame> frames_;
+  MeshTopology topology_;
   long version_ = 0;
   bool moving_ = false;
 

@@ -1,5 +1,6 @@
 #include "mesh/triangle_geometry.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace dem {
@@ -75,6 +76,56 @@ ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3&
   r.wb = v;
   r.wc = w;
   r.region = TriRegion::kFace;
+  return r;
+}
+
+ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                       const Vec3& c, double tolerance) {
+  ClosestPoint r;
+  r.point = a;
+  const Vec3 n = cross(b - a, c - a);
+  const double area2 = norm2(n);
+  if (!(area2 > 0.0)) return r;
+  const Vec3 q = p - (dot(p - a, n) / area2) * n;  // projection onto the plane
+  const double w[3] = {dot(cross(b - q, c - q), n) / area2, dot(cross(c - q, a - q), n) / area2,
+                       dot(cross(a - q, b - q), n) / area2};
+  const Vec3* v[3] = {&a, &b, &c};
+  const double lim = -tolerance;
+  const int negative = (w[0] < lim) + (w[1] < lim) + (w[2] < lim);
+  if (negative == 0) {
+    r.point = q;
+    r.wa = w[0];
+    r.wb = w[1];
+    r.wc = w[2];
+    r.region = TriRegion::kFace;
+    return r;
+  }
+  if (negative == 1) {
+    // Edge opposite the negative coordinate, from node (k + 1) % 3 to node (k + 2) % 3.
+    const int k = w[0] < lim ? 0 : (w[1] < lim ? 1 : 2);
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    const Vec3 e = *v[j] - *v[i];
+    const double t = std::clamp(dot(p - *v[i], e) / norm2(e), 0.0, 1.0);
+    r.point = *v[i] + t * e;
+    double wt[3] = {0.0, 0.0, 0.0};
+    wt[i] = 1.0 - t;
+    wt[j] = t;
+    r.wa = wt[0];
+    r.wb = wt[1];
+    r.wc = wt[2];
+    static constexpr TriRegion kEdgeFrom[3] = {TriRegion::kEdgeAB, TriRegion::kEdgeBC,
+                                              TriRegion::kEdgeCA};
+    r.region = kEdgeFrom[i];
+    return r;
+  }
+  const int k = w[0] >= lim ? 0 : (w[1] >= lim ? 1 : 2);
+  static constexpr TriRegion kVertex[3] = {TriRegion::kVertexA, TriRegion::kVertexB,
+                                           TriRegion::kVertexC};
+  r.point = *v[k];
+  r.wa = k == 0 ? 1.0 : 0.0;
+  r.wb = k == 1 ? 1.0 : 0.0;
+  r.wc = k == 2 ? 1.0 : 0.0;
+  r.region = kVertex[k];
   return r;
 }
 

@@ -27,6 +27,16 @@ struct ClosestPoint {
 // triangle's features. Degenerate triangles are handled (the result is a point of a segment).
 ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
+// The contact point of a sphere centred at p with the triangle as LIGGGHTS 3.8 finds it, from the
+// barycentric coordinates of p projected onto the plane of the triangle, counting those below
+// -tolerance as negative: none negative, the projection (face); one negative, the closest point
+// of the opposite edge (kEdge..., also when that is one of its end points); two negative, the
+// remaining vertex. Differs from closest_point_on_triangle in the region reported, at obtuse
+// angles in the point, and within the tolerance of an edge. Degenerate triangles give their
+// first vertex.
+ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                                       double tolerance);
+
 // Unit normal (b - a) x (c - a) / |...|; the zero vector for a degenerate triangle.
 Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
 double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);

@@ -1,11 +1,13 @@
 #include "output/atom_dump.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <numeric>
 
 #include "core/numbers.h"
 #include "core/simulation.h"
 #include "deck/errors.h"
+#include "deck/line_lexer_internal.h"
 #include "output/output_file.h"
 
 namespace dem {
@@ -34,8 +36,72 @@ void AtomDump::modify(const std::vector<std::string>& args) {
       const long pad = parse_int(value, "dump_modify pad");
       if (pad < 0 || pad > 30) throw EngineError("dump_modify pad must be in 0..30");
       pad_ = static_cast<int>(pad);
+    } else if (key == "format") {
+      if (!accepts_format())
+        throw EngineError("dump_modify format is only supported for dump custom");
+      set_format(value);
     } else {
       Dump::modify({key, value});
+    }
+  }
+}
+
+namespace {
+
+// The printf format for an integer field: exactly one %[flags][width]d|i conversion (plus
+// literal text and %%), rewritten to take a long long.
+std::string integer_format(const std::string& token) {
+  std::string out;
+  int conversions = 0;
+  for (std::size_t i = 0; i < token.size();) {
+    if (token[i] != '%') {
+      out += token[i++];
+      continue;
+    }
+    if (i + 1 < token.size() && token[i + 1] == '%') {
+      out += "%%";
+      i += 2;
+      continue;
+    }
+    std::size_t j = i + 1;
+    while (j < token.size() && std::string("-+ 0#").find(token[j]) != std::string::npos) ++j;
+    while (j < token.size() && token[j] >= '0' && token[j] <= '9') ++j;
+    if (j >= token.size() || (token[j] != 'd' && token[j] != 'i'))
+      throw EngineError("dump_modify format '" + token +
+                        "': an integer field needs one %d conversion");
+    out += token.substr(i, j - i) + "lld";
+    i = j + 1;
+    ++conversions;
+  }
+  if (conversions != 1)
+    throw EngineError("dump_modify format '" + token +
+                      "': an integer field needs exactly one %d conversion");
+  return out;
+}
+
+}  // namespace
+
+void AtomDump::set_format(const std::string& text) {
+  formats_.clear();
+  if (text == "none") return;
+  std::vector<std::string> tokens;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && text[i] == ' ') ++i;
+    std::size_t j = i;
+    while (j < text.size() && text[j] != ' ') ++j;
+    if (j > i) tokens.push_back(text.substr(i, j - i));
+    i = j;
+  }
+  if (tokens.size() < fields_.size())
+    throw EngineError("dump_modify format string is too short (" + std::to_string(tokens.size()) +
+                      " formats for " + std::to_string(fields_.size()) + " fields)");
+  for (std::size_t k = 0; k < fields_.size(); ++k) {
+    if (fields_[k].integer()) {
+      formats_.push_back(integer_format(tokens[k]));
+    } else {
+      deck_lexer::format_number(tokens[k], 0.0);  // validates: one floating-point conversion
+      formats_.push_back(tokens[k]);
     }
   }
 }
@@ -73,6 +139,26 @@ void AtomDump::write() {
 
 // --- dump custom ---------------------------------------------------------------------------
 
+namespace {
+
+// `format` was checked by integer_format to hold one long long conversion.
+std::string integer_text(const std::string& format, long long value) {
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+#endif
+  const int length = std::snprintf(nullptr, 0, format.c_str(), value);
+  std::string out(static_cast<std::size_t>(length > 0 ? length : 0) + 1, '\0');
+  std::snprintf(out.data(), out.size(), format.c_str(), value);
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+  out.resize(static_cast<std::size_t>(length > 0 ? length : 0));
+  return out;
+}
+
+}  // namespace
+
 DumpCustom::DumpCustom(Simulation& sim, const Command& command) : AtomDump(sim, command) {
   const std::string& f = file_;
   if ((f.size() > 3 && f.compare(f.size() - 3, 3, ".gz") == 0) ||
@@ -102,8 +188,14 @@ void DumpCustom::write_snapshot(const Snapshot& snap) {
   text += '\n';
   for (std::size_t i : snap.particles) {
     for (std::size_t k = 0; k < fields_.size(); ++k) {
-      if (k > 0) text += ' ';
       const double value = dump_field_value(fields_[k], atoms, i, snap.compute_values[k]);
+      if (!formats_.empty()) {  // LIGGGHTS: every user format is followed by a blank
+        text += fields_[k].integer() ? integer_text(formats_[k], static_cast<long long>(value))
+                                     : deck_lexer::format_number(formats_[k], value);
+        text += ' ';
+        continue;
+      }
+      if (k > 0) text += ' ';
       text += fields_[k].integer() ? format_integer(static_cast<long long>(value))
                                    : format_number("%g", value);
     }

@@ -10,7 +10,8 @@
 namespace dem {
 
 // Per-particle dumps (custom, custom/vtk): field list, which particles and steps are written,
-// and the dump_modify keywords first, sort and pad (every is handled by Dump).
+// and the dump_modify keywords first, sort, pad and (dump custom only) format; every is
+// handled by Dump.
 class AtomDump : public Dump {
  public:
   AtomDump(Simulation& sim, const Command& command);
@@ -30,8 +31,12 @@ class AtomDump : public Dump {
   bool multi_file() const { return file_.find('*') != std::string::npos; }
 
   std::vector<DumpField> fields_;
+  // dump_modify format: one printf format per field (empty: the default %g / integer).
+  std::vector<std::string> formats_;
+  virtual bool accepts_format() const { return false; }
 
  private:
+  void set_format(const std::string& text);
   std::string expand(long step) const;
   static constexpr long kNever = -1;
   long last_written_ = kNever;
@@ -46,6 +51,7 @@ class DumpCustom : public AtomDump {
   DumpCustom(Simulation& sim, const Command& command);
 
  private:
+  bool accepts_format() const override { return true; }
   void write_snapshot(const Snapshot& snapshot) override;
   std::ofstream stream_;  // single-file mode
 };

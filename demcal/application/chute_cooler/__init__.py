@@ -1,2 +1,3 @@
-"""Sinter chute-cooler segregation (paper Figs. 10-11): set-up, deck, analysis and figures.
+"""Sinter chute-cooler segregation (paper Figs. 10-11): contact parameters, set-up and its
+layout record, meshes, deck, analysis and figures.
 """

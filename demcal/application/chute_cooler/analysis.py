@@ -4,7 +4,7 @@ table and the segregation index, and the files the workflow publishes.
 Reads the run directory written by :func:`demcal.application.chute_cooler.deck.render_chute_cooler`
 after
 the engine has run in it (``case.json``, the text dump, the print file, the VTK dumps); the
-computation is :mod:`demcal.application.chute_cooler.segregation`.
+computation is :mod:`demcal.application.chute_cooler.steady_segregation`.
 """
 
 from __future__ import annotations
@@ -20,16 +20,19 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from demcal.application.chute_cooler.box_layers import Box
 from demcal.application.chute_cooler.deck import load_case
 from demcal.application.chute_cooler.figures import render_fig10, write_mesh_vtk
-from demcal.application.chute_cooler.segregation import Box, SegregationResult, analyse_segregation
-from demcal.application.chute_cooler.setup import (
-    ChuteCoolerSetup,
-    box_row_triangles,
-    chute_triangles,
+from demcal.application.chute_cooler.layout import ChuteCoolerSetup
+from demcal.application.chute_cooler.meshes import box_row_triangles, chute_triangles
+from demcal.application.chute_cooler.steady_segregation import (
+    SegregationResult,
+    analyse_segregation,
 )
-from demcal.decks.stl_mesh import translate
-from demcal.engine_io.output import read_dump, read_print_file, read_vtk_particles
+from demcal.decks.triangle_surface import translate
+from demcal.engine_io.dump_file import read_dump
+from demcal.engine_io.fix_output import read_print_file
+from demcal.engine_io.vtk_file import read_vtk_particles
 
 __all__ = [
     "INDEX_DEFINITION",

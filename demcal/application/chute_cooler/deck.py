@@ -16,20 +16,16 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from demcal.application.chute_cooler.setup import (
-    ChuteCoolerSetup,
-    application_parameters,
-    box_row_triangles,
-    chute_cooler_setup,
-    chute_triangles,
-)
-from demcal.decks.render import case_parameters, template_environment
-from demcal.decks.stl_mesh import write_stl_ascii
+from demcal.application.chute_cooler.contact_parameters import application_parameters
+from demcal.application.chute_cooler.layout import ChuteCoolerSetup
+from demcal.application.chute_cooler.meshes import box_row_triangles, chute_triangles
+from demcal.application.chute_cooler.setup import chute_cooler_setup
+from demcal.core.config_values import SetupError
+from demcal.decks.render import CASE_FILE, render_deck, write_case_directory
+from demcal.particles.material import material_record, material_setup
 from demcal.particles.size_distribution import SizeDistribution, sinter_fines
-from demcal.virtual_tests.shear_cell.setup import MaterialSetup, SetupError, material_setup
 
 __all__ = [
-    "CASE_FILE",
     "DECK_NAME",
     "FILES",
     "application_distribution",
@@ -39,7 +35,6 @@ __all__ = [
 ]
 
 DECK_NAME = "in.chute_cooler"
-CASE_FILE = "case.json"
 TEMPLATE = "chute_cooler.in.j2"
 
 #: Files of the case directory (relative to it).
@@ -127,22 +122,6 @@ def application_distribution(section: Mapping[str, Any]) -> SizeDistribution:
     return sinter_fines(scale=scale, n_largest=classes)
 
 
-def _material_record(mat: MaterialSetup) -> dict[str, Any]:
-    return {
-        "youngsModulus": mat.youngs_modulus,
-        "poissonsRatio": mat.poissons_ratio,
-        "soft_particles": mat.soft_particles,
-        "rolling_friction": mat.rolling_friction,
-        "coefficientFriction": mat.friction,
-        "wallFriction": mat.wall_friction,
-        "coefficientRollingFriction": mat.rolling_friction_coefficient,
-        "coefficientRestitution": mat.restitution,
-        "density": mat.density,
-        "timestep": mat.timestep,
-        "rayleigh_time": mat.rayleigh_time,
-    }
-
-
 def render_chute_cooler(
     settings: Mapping[str, Any],
     out_dir: str | Path,
@@ -185,23 +164,7 @@ def render_chute_cooler(
         seed=int(settings["seed"]),
         skin_factor=float(settings["material"]["skin"]),
     )
-    classes = [
-        (float(r), float(w))
-        for r, w in zip(dist.radii, dist.mass_fractions, strict=True)
-        if w > 0.0
-    ]
-    deck = (
-        template_environment()
-        .get_template(TEMPLATE)
-        .render(
-            case_id="chute_cooler",
-            parameters=case_parameters({"case_id": "chute_cooler", **parameters}),
-            s=setup,
-            mat=mat,
-            files=FILES,
-            classes=classes,
-        )
-    )
+    deck = render_deck(TEMPLATE, "chute_cooler", parameters, setup, mat, FILES, dist)
     record: dict[str, Any] = {
         "deck": DECK_NAME,
         "files": dict(FILES),
@@ -214,19 +177,13 @@ def render_chute_cooler(
             "mass_fractions": [float(w) for w in dist.mass_fractions],
             "number_fractions": [float(w) for w in dist.number_fractions],
         },
-        "material": _material_record(mat),
+        # The application's parameter set has no cohesion.
+        "material": material_record(mat, cohesion=False),
         "setup": setup.as_dict(),
         "analysis": {"plateau_min_fraction": float(section["plateau_min_fraction"])},
     }
-    out = Path(out_dir)
-    (out / "meshes").mkdir(parents=True, exist_ok=True)
-    (out / "vtk").mkdir(parents=True, exist_ok=True)
-    write_stl_ascii(out / FILES["chute"], chute_triangles(setup), name="chute")
-    write_stl_ascii(out / FILES["boxes"], box_row_triangles(setup), name="boxes")
-    (out / DECK_NAME).write_text(deck, encoding="utf-8")
-    (out / CASE_FILE).write_text(
-        json.dumps(record, indent=1, sort_keys=True, allow_nan=False) + "\n", encoding="utf-8"
-    )
+    meshes = {"chute": chute_triangles(setup), "boxes": box_row_triangles(setup)}
+    write_case_directory(out_dir, DECK_NAME, deck, FILES, meshes, record, subdirs=("vtk",))
     return record
 
 

@@ -23,7 +23,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from demcal.application.chute_cooler.segregation import LAYERS, Box, SegregationIndex, SteadyWindow
+from demcal.application.chute_cooler.box_layers import LAYERS, Box
+from demcal.application.chute_cooler.segregation import SegregationIndex
+from demcal.application.chute_cooler.steady_segregation import SteadyWindow
 
 __all__ = [
     "LAYER_COLOURS",
@@ -52,7 +54,7 @@ def plot_fig11(
     Parameters
     ----------
     table : pandas.DataFrame
-        :func:`demcal.application.chute_cooler.segregation.layer_table` output (columns layer,
+        :func:`demcal.application.chute_cooler.box_layers.layer_table` output (columns layer,
         radius (m),
         volume_fraction, share_of_class).
     index : SegregationIndex
@@ -118,7 +120,7 @@ def plot_steady_state(
     Parameters
     ----------
     series : pandas.DataFrame
-        :func:`demcal.application.chute_cooler.segregation.segregation_time_series` output.
+        :func:`demcal.application.chute_cooler.steady_segregation.segregation_time_series` output.
     window : SteadyWindow
         The averaging window.
     path : str or Path

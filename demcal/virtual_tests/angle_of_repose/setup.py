@@ -14,19 +14,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
 from demcal.core import config_values
+from demcal.core.config_values import SetupError
+from demcal.core.parameters import GRAVITY
+from demcal.particles.material import MaterialSetup
+from demcal.particles.run_setup import RunSetup, insertion_seeds, steps_for
 from demcal.particles.size_distribution import SizeDistribution
-from demcal.virtual_tests.shear_cell.setup import (
-    GRAVITY,
-    MaterialSetup,
-    SetupError,
-    prime_seed,
-    steps_for,
-)
 
 __all__ = ["ReposeSetup", "lift_froude_number", "repose_setup"]
 
@@ -37,9 +34,10 @@ _fraction = partial(config_values.fraction, where="angle_of_repose")
 _count = partial(config_values.count, where="angle_of_repose")
 
 
-@dataclass(frozen=True)
-class ReposeSetup:
-    """Every derived number of one angle-of-repose deck (SI units).
+@dataclass(frozen=True, kw_only=True)
+class ReposeSetup(RunSetup):
+    """Every derived number of one angle-of-repose deck (SI units); the run fields are those of
+    :class:`~demcal.particles.run_setup.RunSetup`.
 
     Attributes
     ----------
@@ -59,24 +57,14 @@ class ReposeSetup:
         Particles inserted.
     insertion_radius, insertion_zlo, insertion_zhi : float
         Insertion cylinder, m.
-    box_lo, box_hi : tuple of float
-        Simulation box corners, m.
     lift_distance, lift_speed : float
         m, m/s.
-    timestep, skin : float
-        s, m.
     fill_steps, lift_steps, settle_steps : int
         Steps of filling/settling, lifting and the final settling.
-    print_every, thermo_every : int
-        Steps between rows of the print file and of the thermo output.
-    total_steps : int
-        Steps of the whole run.
     lift_froude : float
         ``v_lift / sqrt(g d_mean)`` with the mass-weighted mean diameter, -.
     n_slices, n_sectors, min_contacts : int
         Readout settings (slice / convex-hull method).
-    seeds : dict of str to int
-        Prime seeds of the insertion and template fixes.
     """
 
     radius: float
@@ -89,30 +77,15 @@ class ReposeSetup:
     insertion_radius: float
     insertion_zlo: float
     insertion_zhi: float
-    box_lo: tuple[float, float, float]
-    box_hi: tuple[float, float, float]
     lift_distance: float
     lift_speed: float
-    timestep: float
-    skin: float
     fill_steps: int
     lift_steps: int
     settle_steps: int
-    print_every: int
-    thermo_every: int
-    total_steps: int
     lift_froude: float
     n_slices: int
     n_sectors: int
     min_contacts: int
-    seeds: dict[str, int] = field(default_factory=dict)
-
-    def as_dict(self) -> dict[str, Any]:
-        """Plain JSON-ready dict."""
-        out = asdict(self)
-        out["box_lo"] = list(self.box_lo)
-        out["box_hi"] = list(self.box_hi)
-        return out
 
 
 def lift_froude_number(lift_speed: float, diameter: float) -> float:
@@ -219,9 +192,5 @@ def repose_setup(
         n_slices=_count(aor, "n_slices", 4),
         n_sectors=_count(aor, "n_sectors", 1),
         min_contacts=_count(aor, "min_contacts", 0),
-        seeds={
-            "insert": prime_seed(seed, 0),
-            "distribution": prime_seed(seed, 1),
-            **{f"template{i + 1}": prime_seed(seed, 2 + i) for i in range(dist.n_classes)},
-        },
+        seeds=insertion_seeds(seed, dist.n_classes),
     )

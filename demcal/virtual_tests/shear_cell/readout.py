@@ -1,7 +1,7 @@
 """Bulk values of the virtual Schulze shear test: mu_psh, mu_sh and rho_b per pre-shear cycle.
 
 Input is the table of the deck's ``fix print`` file (read by
-:func:`demcal.engine_io.output.read_print_file`), one row per print step, with the columns
+:func:`demcal.engine_io.fix_output.read_print_file`), one row per print step, with the columns
 
 =============  ==========================================================================
 time           s
@@ -25,7 +25,7 @@ The split-cylinder cell of radius ``R`` has its floor at ``z_floor`` and its she
 * ``tau = |shear_force| / A`` and ``mu = tau / sigma``.
 
 ``mu_psh`` and ``mu_sh`` are the means of ``mu`` over the steady plateaus detected (by
-:func:`demcal.virtual_tests.steady_state.detect_plateau`) in the pre-shear and the shear phase of a
+:func:`demcal.core.steady_state.detect_plateau`) in the pre-shear and the shear phase of a
 cycle;
 ``rho_b`` is averaged over the pre-shear plateau. ``P`` is the ratio of the servo target forces
 of shear and pre-shear, and ``normal_stress`` the pre-shear target force over ``pi R^2``.
@@ -38,8 +38,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from demcal.engine_io.output import require_columns
-from demcal.virtual_tests.steady_state import Plateau, detect_plateau
+from demcal.core.parameters import GRAVITY
+from demcal.core.steady_state import Plateau, detect_plateau
+from demcal.engine_io.output_errors import require_columns
 
 __all__ = [
     "PHASE_PRE_SHEAR",
@@ -145,7 +146,7 @@ def shear_stress_series(
     radius: float,
     z_floor: float,
     z_shear: float,
-    g: float = 9.81,
+    g: float = GRAVITY,
 ) -> pd.DataFrame:
     """Add the time series of area, bulk density, stresses and mu to a shear-cell table.
 
@@ -170,7 +171,7 @@ def shear_stress_series(
 
     Raises
     ------
-    demcal.engine_io.output.MissingColumnError
+    demcal.engine_io.output_errors.MissingColumnError
         A required column is absent.
     ValueError
         Non-finite values, a lid at or below the shear plane, or a travel of 2R or more
@@ -214,7 +215,7 @@ def shear_cell_bulk_values(
     radius: float,
     z_floor: float,
     z_shear: float,
-    g: float = 9.81,
+    g: float = GRAVITY,
     **plateau_kwargs: Any,
 ) -> pd.DataFrame:
     """Bulk values of every pre-shear/shear cycle of a shear-cell run.
@@ -232,7 +233,7 @@ def shear_cell_bulk_values(
     g : float
         Gravitational acceleration (m/s^2).
     **plateau_kwargs
-        Passed on to :func:`demcal.virtual_tests.steady_state.detect_plateau` (e.g.
+        Passed on to :func:`demcal.core.steady_state.detect_plateau` (e.g.
         ``min_fraction``).
 
     Returns
@@ -247,7 +248,7 @@ def shear_cell_bulk_values(
 
     Raises
     ------
-    demcal.engine_io.output.MissingColumnError
+    demcal.engine_io.output_errors.MissingColumnError
         A required column is absent.
     ValueError
         Invalid geometry or table values (see :func:`shear_stress_series`), a non-positive

@@ -1,5 +1,4 @@
-"""Derived quantities of the virtual Schulze shear test, and the particle and material set-up
-that both virtual tests share.
+"""Derived quantities of the virtual Schulze shear test.
 
 Everything a shear-cell deck needs is computed here from the case row (contact parameters,
 ``dCylDp``, ``normal_stress``) and the configuration sections ``particles``, ``material`` and
@@ -23,203 +22,44 @@ compresses it.
 
 Schulze sequence
 ----------------
-Phase 0: settle, scrape, compress with the servo lid to the pre-shear load. Then one cycle per
-value of P: pre-shear at the full load (phase 1), unload the lid to ``unload_force_fraction`` of
-that load with the lower part at rest (phase 2), shear at ``P`` times the pre-shear load
-(phase 3). The lower part moves at ``shear_speed * r_ref`` per second; a pre-shear lasts
+The phases and cycles are laid out by :mod:`demcal.virtual_tests.shear_cell.schedule`. The
+lower part moves at ``shear_speed * r_ref`` per second; a pre-shear lasts
 ``preshear_travel * R / v`` and a shear ``shear_travel_ratio`` of that (the authors' 0.1875 R and
 19/20). A case row with a ``P`` column runs that single cycle (one deck per load condition);
-otherwise all values of ``shear_cell.P`` follow each other in one deck, in one of two ways
-(``shear_cell.cycles``, see :func:`shear_cell_setup`): "return" (every cycle starts at zero
-offset; in between the lower part returns with the lid unloaded and the sample is compressed
-again) or "alternate" (the direction alternates, the offset swings between +h and -h).
+otherwise all values of ``shear_cell.P`` follow each other in one deck.
 
-Time step
----------
-``dt = rayleigh_fraction * t_R`` with the Rayleigh time of the smallest particle
-``t_R = pi r sqrt(rho / G) / (0.1631 nu + 0.8766)``, ``G = Y / (2 (1 + nu))``, rounded down to
-three significant digits (so the deck holds exactly the value used here), unless a fixed
-``material.timestep`` is given.
+The time step and the material come from :mod:`demcal.particles.material`.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from demcal.core import config_values
 from demcal.core.config_values import SetupError
-from demcal.particles.size_distribution import SizeDistribution, monodisperse, sinter_fines
+from demcal.core.parameters import GRAVITY
+from demcal.particles.material import MaterialSetup
+from demcal.particles.run_setup import RunSetup, insertion_seeds, steps_for
+from demcal.particles.size_distribution import SizeDistribution
+from demcal.virtual_tests.shear_cell.schedule import (
+    DeckSegment,
+    ShearCycle,
+    schulze_schedule,
+)
 
 __all__ = [
-    "GRAVITY",
-    "MaterialSetup",
-    "SetupError",
     "ShearCellSetup",
-    "ShearCycle",
     "inertial_number",
-    "material_setup",
-    "prime_seed",
-    "rayleigh_time",
-    "round_down_sig",
     "shear_cell_setup",
     "shear_cell_youngs_modulus",
-    "size_distribution",
-    "steps_for",
-    "time_step",
 ]
-
-#: Gravitational acceleration, m/s^2.
-GRAVITY = 9.81
-
-
-# ----------------------------------------------------------------------------------------------
-# shared helpers: particles, material, time step, seeds
 
 _get = config_values.required
 _positive = config_values.positive_value
 _fraction = config_values.fraction_value
-
-
-def size_distribution(particles: Mapping[str, Any]) -> SizeDistribution:
-    """Particle size distribution of the ``particles`` configuration section.
-
-    Parameters
-    ----------
-    particles : mapping
-        ``distribution`` ("monodisperse" or "sinter_fines"), ``radius`` (m, monodisperse),
-        ``scale`` (-, factor on the sinter-fines radii) and ``classes`` (number of the largest
-        sieve classes kept, 1-6).
-
-    Returns
-    -------
-    SizeDistribution
-        Radii (m) and mass fractions.
-    """
-    kind = _get(particles, "distribution", "particles")
-    if kind == "monodisperse":
-        return monodisperse(_positive(_get(particles, "radius", "particles"), "particles.radius"))
-    if kind == "sinter_fines":
-        scale = _positive(_get(particles, "scale", "particles"), "particles.scale")
-        classes = int(_get(particles, "classes", "particles"))
-        if not 1 <= classes <= 6:
-            raise SetupError(f"configuration: 'particles.classes' must be in 1..6, got {classes}")
-        return sinter_fines(scale=scale, n_largest=classes)
-    raise SetupError(
-        f"configuration: 'particles.distribution' must be 'monodisperse' or 'sinter_fines', "
-        f"got {kind!r}"
-    )
-
-
-def rayleigh_time(radius: float, density: float, youngs_modulus: float, poisson: float) -> float:
-    """Rayleigh time ``pi r sqrt(rho / G) / (0.1631 nu + 0.8766)``, s.
-
-    Parameters
-    ----------
-    radius : float
-        Particle radius, m.
-    density : float
-        Particle density, kg/m^3.
-    youngs_modulus : float
-        Young's modulus, Pa.
-    poisson : float
-        Poisson's ratio, -.
-    """
-    shear_modulus = youngs_modulus / (2.0 * (1.0 + poisson))
-    return math.pi * radius * math.sqrt(density / shear_modulus) / (0.1631 * poisson + 0.8766)
-
-
-def round_down_sig(x: float, digits: int = 3) -> float:
-    """``x > 0`` rounded down to ``digits`` significant digits (exactly representable text)."""
-    if not (math.isfinite(x) and x > 0.0):
-        raise ValueError(f"round_down_sig needs a positive finite number, got {x}")
-    exponent = math.floor(math.log10(x)) - digits + 1
-    mantissa = math.floor(x / 10.0**exponent * (1.0 + 1e-12))
-    # Through the decimal text, so that repr() of the result is short and exact.
-    return float(f"{mantissa}e{exponent}")
-
-
-@dataclass(frozen=True)
-class MaterialSetup:
-    """Material constants and contact-model switches of one case.
-
-    Attributes
-    ----------
-    youngs_modulus : float
-        Young's modulus of particles and walls, Pa.
-    poissons_ratio : float
-        Poisson's ratio, -.
-    soft_particles : bool
-        Deck needs ``soft_particles yes`` (Young's modulus below 5e6 Pa).
-    rolling_friction : bool
-        ``rolling_friction epsd2`` in the contact model.
-    cohesion : bool
-        ``cohesion sjkr`` (the case has cohesionEnergyDensity > 0).
-    friction, rolling_friction_coefficient, restitution, cohesion_energy_density : float
-        Particle-particle values (-, -, -, J/m^3).
-    wall_friction : float
-        Particle-wall sliding friction (case column wallFriction, else the particle value), -.
-    density : float
-        Particle density, kg/m^3.
-    timestep : float
-        Time step, s.
-    rayleigh_time : float
-        Rayleigh time of the smallest particle, s.
-    """
-
-    youngs_modulus: float
-    poissons_ratio: float
-    soft_particles: bool
-    rolling_friction: bool
-    cohesion: bool
-    friction: float
-    rolling_friction_coefficient: float
-    restitution: float
-    cohesion_energy_density: float
-    wall_friction: float
-    density: float
-    timestep: float
-    rayleigh_time: float
-
-    def pair_matrix(self, particle: float, wall: float) -> list[float]:
-        """Row-major 2x2 type-pair matrix (type 1 particles, type 2 walls), shape (4,)."""
-        return [particle, wall, wall, wall]
-
-
-def time_step(
-    dist: SizeDistribution,
-    density: float,
-    youngs_modulus: float,
-    poissons_ratio: float,
-    fixed: float,
-    rayleigh_fraction: float,
-) -> float:
-    """Time step of a case, s.
-
-    Parameters
-    ----------
-    dist : SizeDistribution
-        Particle sizes; the smallest radius sets the Rayleigh time.
-    density : float
-        Particle density, kg/m^3.
-    youngs_modulus, poissons_ratio : float
-        Pa, -.
-    fixed : float
-        A fixed time step (s), or 0 to derive it from the Rayleigh time.
-    rayleigh_fraction : float
-        Fraction of the Rayleigh time used when ``fixed`` is 0.
-
-    Returns
-    -------
-    float
-        ``fixed`` or ``rayleigh_fraction * t_R`` rounded down to three significant digits.
-    """
-    if fixed > 0.0:
-        return float(fixed)
-    t_r = rayleigh_time(dist.min_radius, density, youngs_modulus, poissons_ratio)
-    return round_down_sig(rayleigh_fraction * t_r)
 
 
 def shear_cell_youngs_modulus(
@@ -240,98 +80,6 @@ def shear_cell_youngs_modulus(
         cap = float(_get(cell, "youngs_modulus_max", "shear_cell"))
         return min(ratio * float(case["normal_stress"]), cap)
     return float(_get(material, "youngsModulus", "material"))
-
-
-def material_setup(
-    case: Mapping[str, Any],
-    material: Mapping[str, Any],
-    dist: SizeDistribution,
-    youngs_modulus: float | None = None,
-) -> MaterialSetup:
-    """Material constants of a case: contact parameters from the case row, the rest from the
-    ``material`` configuration section (a case column youngsModulus / poissonsRatio overrides
-    the configuration).
-
-    Parameters
-    ----------
-    case : mapping
-        Design row with coefficientFriction, coefficientRollingFriction,
-        coefficientRestitution, density and optionally cohesionEnergyDensity, wallFriction,
-        youngsModulus, poissonsRatio.
-    material : mapping
-        Configuration section ``material``.
-    dist : SizeDistribution
-        Particle sizes (for the time step).
-    youngs_modulus : float, optional
-        Young's modulus to use (Pa), e.g. from :func:`shear_cell_youngs_modulus`.
-    """
-    if youngs_modulus is None:
-        youngs_modulus = case.get("youngsModulus", _get(material, "youngsModulus", "material"))
-    youngs = float(youngs_modulus)
-    poisson = float(case.get("poissonsRatio", _get(material, "poissonsRatio", "material")))
-    density = float(case["density"])
-    friction = float(case["coefficientFriction"])
-    cohesion = float(case.get("cohesionEnergyDensity", 0.0))
-    wall_friction = case.get("wallFriction", friction)
-    if wall_friction is None or (isinstance(wall_friction, float) and math.isnan(wall_friction)):
-        wall_friction = friction
-    fixed = float(_get(material, "timestep", "material"))
-    fraction = _positive(
-        _get(material, "rayleigh_fraction", "material"), "material.rayleigh_fraction"
-    )
-    return MaterialSetup(
-        youngs_modulus=youngs,
-        poissons_ratio=poisson,
-        soft_particles=bool(_get(material, "soft_particles", "material")),
-        rolling_friction=bool(_get(material, "rolling_friction", "material")),
-        cohesion=cohesion > 0.0,
-        friction=friction,
-        rolling_friction_coefficient=float(case["coefficientRollingFriction"]),
-        restitution=float(case["coefficientRestitution"]),
-        cohesion_energy_density=cohesion,
-        wall_friction=float(wall_friction),
-        density=density,
-        timestep=time_step(dist, density, youngs, poisson, fixed, fraction),
-        rayleigh_time=rayleigh_time(dist.min_radius, density, youngs, poisson),
-    )
-
-
-def _is_prime(n: int) -> bool:
-    if n < 2:
-        return False
-    if n % 2 == 0:
-        return n == 2
-    k = 3
-    while k * k <= n:
-        if n % k == 0:
-            return False
-        k += 2
-    return True
-
-
-def prime_seed(seed: int, k: int) -> int:
-    """The k-th (k >= 0) prime above ``10007 + 1000 * (seed mod 10**6)``.
-
-    LIGGGHTS insertion and template fixes take large primes as seeds; this maps the
-    configuration seed to distinct, reproducible primes.
-    """
-    if k < 0:
-        raise ValueError(f"k must be >= 0, got {k}")
-    n = 10007 + 1000 * (int(seed) % 1_000_000)
-    found = -1
-    while True:
-        n += 1
-        if _is_prime(n):
-            found += 1
-            if found == k:
-                return n
-
-
-def steps_for(duration: float, dt: float) -> int:
-    """Whole number of steps (at least 1) covering ``duration`` (s) at time step ``dt`` (s)."""
-    if not (duration > 0.0 and dt > 0.0):
-        raise ValueError(f"duration and dt must be positive, got {duration}, {dt}")
-    return max(1, math.ceil(duration / dt - 1e-9))
 
 
 def inertial_number(
@@ -356,104 +104,10 @@ def inertial_number(
     return shear_speed / (band_width * math.sqrt(pressure / density))
 
 
-# ----------------------------------------------------------------------------------------------
-# shear cell
-
-
-@dataclass(frozen=True)
-class DeckSegment:
-    """One ``run`` of the shear-cell deck with constant settings.
-
-    Attributes
-    ----------
-    label : str
-        What the segment does (written as a comment into the deck).
-    phase, cycle : int
-        Values of the print columns ``phase`` and ``cycle``.
-    target_force : float
-        Lid force the servo holds, N (positive).
-    target_val : float
-        The servo's ``target_val``, ``-target_force`` (the lid pushes towards -z), N.
-    ctrl : tuple of float
-        Servo gains (kp, ki, kd): the configured gains times ``target_force`` over the
-        pre-shear force. LIGGGHTS divides the force error by the target, so this keeps the lid's
-        response to a given force error the same in every segment (a tiny unload target would
-        otherwise make the lid chatter at full speed).
-    moving : bool
-        Whether the lower part moves.
-    velocity : float
-        x velocity of the lower part, m/s (0 at rest).
-    travel_per_step : float
-        x displacement of the lower part per step, m.
-    offset_start : float
-        x offset of the lower part against the upper ring at the first step, m.
-    start_step, steps : int
-        First step and number of steps.
-    snapshot : bool
-        Write the particle snapshot (VTK) at the end of the segment.
-    """
-
-    label: str
-    phase: int
-    cycle: int
-    target_force: float
-    target_val: float
-    ctrl: tuple[float, float, float]
-    moving: bool
-    velocity: float
-    travel_per_step: float
-    offset_start: float
-    start_step: int
-    steps: int
-    snapshot: bool = False
-
-    @property
-    def end_step(self) -> int:
-        """Last step of the segment."""
-        return self.start_step + self.steps
-
-    @property
-    def offset_end(self) -> float:
-        """x offset of the lower part at the last step, m."""
-        return self.offset_start + self.steps * self.travel_per_step
-
-
-@dataclass(frozen=True)
-class ShearCycle:
-    """One pre-shear / unload / shear cycle (the readout's view of the deck).
-
-    Attributes
-    ----------
-    index : int
-        Cycle number (0, 1, ...).
-    P : float
-        Shear load as a fraction of the pre-shear load, -.
-    direction : int
-        -1 (lower part moves towards -x) or +1.
-    preshear_force, shear_force : float
-        Servo target lid forces of pre-shear and shear, N.
-    preshear_start_step, preshear_end_step, shear_start_step, shear_end_step : int
-        First and last steps of the pre-shear and the shear phase.
-    offset_preshear_start, offset_shear_end : float
-        x offset of the lower part at the start of the pre-shear and at the end of the shear, m.
-    """
-
-    index: int
-    P: float
-    direction: int
-    preshear_force: float
-    shear_force: float
-    preshear_start_step: int
-    preshear_end_step: int
-    shear_start_step: int
-    shear_end_step: int
-    offset_preshear_start: float
-    offset_shear_end: float
-
-
-@dataclass(frozen=True)
-class ShearCellSetup:
-    """Every derived number of one shear-cell deck (SI units).
+@dataclass(frozen=True, kw_only=True)
+class ShearCellSetup(RunSetup):
+    """Every derived number of one shear-cell deck (SI units); the run fields are those of
+    :class:`~demcal.particles.run_setup.RunSetup`.
 
     Attributes
     ----------
@@ -480,8 +134,6 @@ class ShearCellSetup:
         are deleted, m.
     insertion_radius, insertion_zlo, insertion_zhi : float
         Insertion cylinder, m.
-    box_lo, box_hi : tuple of float
-        Simulation box corners, m.
     lid_gap : float
         Lid start height above the highest particle centre, m.
     normal_stress : float
@@ -494,27 +146,19 @@ class ShearCellSetup:
         Speed of the lower part during pre-shear and shear, m/s.
     servo_vel_max, servo_kp, servo_ki, servo_kd : float
         Servo parameters (m/s, -, -, -).
-    timestep, skin : float
-        s, m.
     fill_steps : int
         Steps of the free fall and settling before the lid is placed.
     segments : tuple of DeckSegment
         Every later ``run`` of the deck, in order (phase 0 compression onwards).
     cycles : tuple of ShearCycle
         One per value of P, in order.
-    print_every, thermo_every : int
-        Steps between rows of the print file and of the thermo output.
     snapshot_step : int
         Step of the particle snapshot at the end of the first pre-shear.
-    total_steps : int
-        Steps of the whole run.
     preshear_time, shear_time, unload_time : float
         Durations, s.
     inertial_number_min_stress : float
         Inertial number of the shear band (10 particle diameters wide) at the smallest shear
         normal stress, -.
-    seeds : dict of str to int
-        Prime seeds of the insertion and template fixes.
     """
 
     radius: float
@@ -532,8 +176,6 @@ class ShearCellSetup:
     insertion_radius: float
     insertion_zlo: float
     insertion_zhi: float
-    box_lo: tuple[float, float, float]
-    box_hi: tuple[float, float, float]
     lid_gap: float
     normal_stress: float
     preshear_force: float
@@ -543,20 +185,14 @@ class ShearCellSetup:
     servo_kp: float
     servo_ki: float
     servo_kd: float
-    timestep: float
-    skin: float
     fill_steps: int
     segments: tuple[DeckSegment, ...]
     cycles: tuple[ShearCycle, ...]
-    print_every: int
-    thermo_every: int
     snapshot_step: int
-    total_steps: int
     preshear_time: float
     shear_time: float
     unload_time: float
     inertial_number_min_stress: float
-    seeds: dict[str, int] = field(default_factory=dict)
 
     @property
     def cross_section(self) -> float:
@@ -565,9 +201,7 @@ class ShearCellSetup:
 
     def as_dict(self) -> dict[str, Any]:
         """Plain JSON-ready dict (segments and cycles as lists of dicts)."""
-        out = asdict(self)
-        out["box_lo"] = list(self.box_lo)
-        out["box_hi"] = list(self.box_hi)
+        out = super().as_dict()
         out["cross_section"] = self.cross_section
         for seg in out["segments"]:
             seg["ctrl"] = list(seg["ctrl"])
@@ -584,49 +218,6 @@ def _p_values(values: Sequence[Any]) -> list[float]:
     return ps
 
 
-class _Timeline:
-    """Appends deck segments one after the other, tracking step and offset."""
-
-    def __init__(self, start_step: int, force: float, gains: tuple[float, float, float]):
-        self.step = start_step
-        self.offset = 0.0
-        self.force = force
-        self.gains = gains
-        self.segments: list[DeckSegment] = []
-
-    def add(
-        self,
-        label: str,
-        phase: int,
-        cycle: int,
-        target: float,
-        steps: int,
-        velocity: float = 0.0,
-        dt: float = 0.0,
-        snapshot: bool = False,
-    ) -> DeckSegment:
-        factor = target / self.force
-        seg = DeckSegment(
-            label=label,
-            phase=phase,
-            cycle=cycle,
-            target_force=target,
-            target_val=-target,
-            ctrl=(self.gains[0] * factor, self.gains[1] * factor, self.gains[2] * factor),
-            moving=velocity != 0.0,
-            velocity=velocity,
-            travel_per_step=velocity * dt,
-            offset_start=self.offset,
-            start_step=self.step,
-            steps=steps,
-            snapshot=snapshot,
-        )
-        self.segments.append(seg)
-        self.step = seg.end_step
-        self.offset = seg.offset_end
-        return seg
-
-
 def shear_cell_setup(
     dCylDp: float,
     normal_stress: float,
@@ -638,16 +229,8 @@ def shear_cell_setup(
 ) -> ShearCellSetup:
     """Derived quantities of one shear-cell case.
 
-    Two ways of running several cycles (``shear_cell.cycles``):
-
-    * ``"alternate"``: after the compression the lower part moves under load to ``+h``, half
-      the travel of one cycle; cycle k then moves towards -x for even k and +x for odd k, so the
-      offset swings between ``+h`` and ``-h``, every cycle starts after a reversal and sweeps
-      the same, mirrored geometry.
-    * ``"return"``: every cycle moves towards -x from zero offset; between cycles the lid is
-      unloaded to ``unload_force_fraction`` of the pre-shear force, the lower part returns to
-      zero offset at ``return_speed`` times the shear speed, and the lid compresses the sample
-      again (phase 0 of the next cycle). Every cycle then starts like a fresh test.
+    Several cycles follow each other as ``shear_cell.cycles`` says ("alternate" or "return",
+    see :func:`demcal.virtual_tests.shear_cell.schedule.schulze_schedule`).
 
     Parameters
     ----------
@@ -756,64 +339,23 @@ def shear_cell_setup(
     n_psh = steps_for(t_psh, dt)
     n_unload = steps_for(t_unload, dt)
     n_sh = steps_for(t_sh, dt)
-    n_cycle_travel = n_psh + n_sh
-
-    line = _Timeline(fill_steps, force, (kp, ki, kd))
-    line.add("phase 0: compress to the pre-shear load", 0, 0, force, compress_steps)
-    if mode == "alternate":
-        n_pos = max(1, n_cycle_travel // 2)
-        line.add("phase 0: move the lower part to +h under load", 0, 0, force, n_pos, speed, dt)
-    cycles = []
-    for k, p in enumerate(p_values):
-        direction = -1 if (mode == "return" or k % 2 == 0) else 1
-        towards = "-x" if direction < 0 else "+x"
-        if mode == "return" and k > 0:
-            line.add(f"cycle {k}: unload", 0, k, unload_fraction * force, n_unload)
-            back = (n_cycle_travel * speed * dt) / return_speed
-            n_back = steps_for(back, dt)
-            # Exactly back to zero offset in whole steps.
-            v_back = -line.offset / (n_back * dt)
-            line.add(
-                f"cycle {k}: return to zero offset",
-                0,
-                k,
-                unload_fraction * force,
-                n_back,
-                v_back,
-                dt,
-            )
-            line.add(f"cycle {k}: compress to the pre-shear load", 0, k, force, compress_steps)
-        pre = line.add(
-            f"cycle {k}: pre-shear (P = {p:g}), lower part towards {towards}",
-            1,
-            k,
-            force,
-            n_psh,
-            direction * speed,
-            dt,
-            snapshot=k == 0,
-        )
-        line.add(f"cycle {k}: unload", 2, k, unload_fraction * force, n_unload)
-        sh = line.add(
-            f"cycle {k}: shear at P = {p:g}", 3, k, p * force, n_sh, direction * speed, dt
-        )
-        cycles.append(
-            ShearCycle(
-                index=k,
-                P=p,
-                direction=direction,
-                preshear_force=force,
-                shear_force=p * force,
-                preshear_start_step=pre.start_step,
-                preshear_end_step=pre.end_step,
-                shear_start_step=sh.start_step,
-                shear_end_step=sh.end_step,
-                offset_preshear_start=pre.offset_start,
-                offset_shear_end=sh.offset_end,
-            )
-        )
-
-    max_offset = max(max(abs(seg.offset_start), abs(seg.offset_end)) for seg in line.segments)
+    schedule = schulze_schedule(
+        mode=mode,
+        p_values=p_values,
+        force=force,
+        gains=(kp, ki, kd),
+        start_step=fill_steps,
+        compress_steps=compress_steps,
+        preshear_steps=n_psh,
+        unload_steps=n_unload,
+        shear_steps=n_sh,
+        speed=speed,
+        return_speed=return_speed,
+        unload_fraction=unload_fraction,
+        dt=dt,
+    )
+    cycles = schedule.cycles
+    max_offset = schedule.max_offset
     flange = max_offset + 4.0 * r_max
     margin = 4.0 * r_max
     half_x = radius + flange + max_offset + margin
@@ -857,19 +399,15 @@ def shear_cell_setup(
         timestep=dt,
         skin=skin,
         fill_steps=fill_steps,
-        segments=tuple(line.segments),
-        cycles=tuple(cycles),
+        segments=schedule.segments,
+        cycles=cycles,
         print_every=max(1, n_psh // samples),
-        thermo_every=max(1, (line.step - fill_steps) // 50),
+        thermo_every=max(1, (schedule.end_step - fill_steps) // 50),
         snapshot_step=cycles[0].preshear_end_step,
-        total_steps=line.step,
+        total_steps=schedule.end_step,
         preshear_time=t_psh,
         shear_time=t_sh,
         unload_time=t_unload,
         inertial_number_min_stress=inertial_number(speed, 10.0, smallest_stress, material.density),
-        seeds={
-            "insert": prime_seed(seed, 0),
-            "distribution": prime_seed(seed, 1),
-            **{f"template{i + 1}": prime_seed(seed, 2 + i) for i in range(dist.n_classes)},
-        },
+        seeds=insertion_seeds(seed, dist.n_classes),
     )

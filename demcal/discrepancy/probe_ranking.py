@@ -1,0 +1,299 @@
+"""Name the missing effect on files: the candidates scored with their probe runs and ranked
+(discrepancy workflow, step 2; the method is in :mod:`demcal.discrepancy.ranking`), and the
+ranking's outputs with the extended design of the named effect."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from demcal.core.experiments import Experiment, load_experiment
+from demcal.core.provenance import write_sidecar
+from demcal.discrepancy.candidates import (
+    REFERENCE_CASE,
+    Candidate,
+    applicability,
+    extended_design,
+    parse_candidates,
+)
+from demcal.discrepancy.effect_response import EffectResponse, response_signature
+from demcal.discrepancy.find import FindResult, find
+from demcal.discrepancy.model_from_files import (
+    build_model,
+    load_surrogates,
+    surrogate_constants,
+)
+from demcal.discrepancy.observations import SurrogateModel
+from demcal.discrepancy.ranking import fit_candidate, null_fit, rank_candidates, ranking_sigma
+from demcal.discrepancy.report import ranking_markdown
+from demcal.discrepancy.run_results import read_runs, run_values
+
+__all__ = ["RankingResult", "rank", "ranking_record", "write_ranking"]
+
+
+@dataclass
+class RankingResult:
+    """Outcome of the Name step.
+
+    Attributes
+    ----------
+    table : DataFrame
+        One row per candidate of the catalogue (ranked ones first), with description,
+        parameter, status and signature.
+    winner : Candidate or None
+    fits : dict
+        Candidate name -> CandidateFit.
+    find : FindResult
+        The Find result on the observations used in the ranking.
+    null_deviance : float
+        Deviance D_0 of "nothing missing" with the ranking weights.
+    notes : list[str]
+        Observations or probe levels left out, and why.
+    """
+
+    table: pd.DataFrame
+    winner: Candidate | None
+    fits: dict
+    find: FindResult
+    null_deviance: float
+    notes: list[str] = field(default_factory=list)
+
+
+def rank(
+    model_paths: Mapping[str, str | Path],
+    experiment: Experiment,
+    config: Mapping[str, Any],
+    runs: pd.DataFrame,
+    probe_point: Mapping[str, float],
+) -> RankingResult:
+    """Score every applicable candidate with its probe runs and rank them (BIC).
+
+    ``probe_point`` is the parameter set the probes ran at (``point`` of the Find record); it
+    gives the "absent" magnitude of a candidate whose absence is another parameter's value.
+
+    Observations whose reference probe run gave no value are left out of the ranking (and the
+    null fit is redone without them); a probe level with a missing value is dropped for its
+    candidate; a candidate without any usable level is reported as not scored.
+    """
+    settings = config["discrepancy"]
+    candidates = parse_candidates(settings["candidates"])
+    surrogates, rmse = load_surrogates(model_paths)
+    model, box = build_model(surrogates, rmse, experiment, config)
+    obs = model.observations
+    notes: list[str] = []
+    reference = run_values(runs, REFERENCE_CASE, obs)
+    keep = np.isfinite(reference)
+    if not keep.any():
+        raise ValueError("the reference probe run gave no value for any observation")
+    if not keep.all():
+        dropped = obs[~keep]
+        notes.append(
+            "left out (no value in the reference run): "
+            + ", ".join(f"{r.observable} at {r.normal_stress:g} Pa" for r in dropped.itertuples())
+        )
+        model = SurrogateModel(
+            surrogates, obs[keep], model.parameters, surrogate_constants(config)
+        )
+        obs = model.observations
+        reference = reference[keep]
+    null = find(
+        model,
+        box,
+        int(settings["grid_points"]),
+        float(settings["gap_threshold"]),
+        float(settings["fit_z"]),
+    )
+    grid = box.grid(int(settings["grid_points"]))
+    predictions = model.predict(grid)
+    noise = obs["surrogate_rmse"].to_numpy(float)
+    weights = ranking_sigma(obs["sigma"].to_numpy(float), noise)
+    null_weighted = null_fit(model, box, grid, predictions, weights)
+    point = {k: float(v) for k, v in probe_point.items()}
+    fits = {}
+    rows = []
+    for cand in candidates:
+        row: dict[str, Any] = {
+            "candidate": cand.name,
+            "description": cand.description,
+            "parameter": cand.parameter,
+        }
+        ok, reason = applicability(cand, config)
+        if not ok:
+            rows.append({**row, "status": f"not applicable: {reason}"})
+            continue
+        mags, values = [], []
+        for j, level in enumerate(cand.probe_levels):
+            vals = run_values(runs, cand.case_id(j), obs)
+            if np.all(np.isfinite(vals)):
+                mags.append(level)
+                values.append(vals)
+            else:
+                notes.append(f"{cand.name}: probe level {level:g} dropped (a run gave no value)")
+        if not mags:
+            rows.append({**row, "status": "not scored: no usable probe run"})
+            continue
+        response = EffectResponse.from_runs(
+            cand.name,
+            [cand.off_magnitude(point), *mags],
+            np.vstack([reference, *values]),
+            reference=0,
+            integer=cand.integer,
+        )
+        if response.magnitudes.size < 2:
+            rows.append({**row, "status": "not scored: probe levels equal the absent value"})
+            continue
+        fit = fit_candidate(
+            model,
+            box,
+            grid,
+            predictions,
+            response,
+            weights,
+            int(settings["magnitude_points"]),
+        )
+        fits[cand.name] = fit
+        signature = response_signature(obs, response, reference, noise)
+        rows.append({**row, "status": "scored", "signature": signature})
+    scored, winner_name = rank_candidates(
+        null_weighted.deviance,
+        fits,
+        len(obs),
+        float(settings["min_delta_bic"]),
+        float(settings["min_explained"]),
+    )
+    unscored = [r["candidate"] for r in rows if r["status"].startswith("not scored")]
+    if winner_name is not None and unscored:
+        notes.append(
+            f"{winner_name} leads, but is not named: {', '.join(unscored)} could not be scored"
+        )
+        winner_name = None
+    info = pd.DataFrame(rows)
+    table = scored.merge(info, on="candidate", how="right")
+    table = table.sort_values(["rank"], na_position="last", kind="stable").reset_index(drop=True)
+    table["named"] = table["candidate"] == winner_name
+    table.loc[table["status"] == "scored", "status"] = np.where(
+        table.loc[table["status"] == "scored", "named"], "named", "not significant"
+    )
+    winner = next((c for c in candidates if c.name == winner_name), None)
+    return RankingResult(table, winner, fits, null, null_weighted.deviance, notes)
+
+
+def ranking_record(result: RankingResult) -> dict[str, Any]:
+    """JSON record of a ranking: the winner, the scored candidates and the winner's fit."""
+    scored = result.table[result.table["rank"].notna()]
+    record: dict[str, Any] = {
+        "winner": result.winner.name if result.winner else None,
+        "ran": True,
+        "n_observations": len(result.find.observations),
+        "null_deviance": result.null_deviance,
+        "notes": result.notes,
+        "ranking": [
+            {
+                "candidate": r.candidate,
+                "delta_bic": float(r.delta_bic),
+                "magnitude": float(r.magnitude),
+                "explained": float(r.explained),
+            }
+            for r in scored.itertuples()
+        ],
+    }
+    if result.winner is not None:
+        fit = result.fits[result.winner.name]
+        record.update(
+            {
+                "parameter": result.winner.parameter,
+                "magnitude": fit.magnitude,
+                "theta": fit.best.theta,
+            }
+        )
+    return record
+
+
+def _empty(path: str | Path, columns: list[str]) -> None:
+    pd.DataFrame(columns=columns).to_csv(path, index=False)
+
+
+def write_ranking(
+    model_paths: Mapping[str, str | Path],
+    experiment_path: str | Path,
+    config: Mapping[str, Any],
+    find_record_path: str | Path,
+    probe_files: Iterable[str | Path],
+    table_path: str | Path,
+    markdown_path: str | Path,
+    record_path: str | Path,
+    probes_path: str | Path,
+    design_path: str | Path,
+) -> RankingResult | None:
+    """Rank the candidates and write the ranking, its record and the extended design.
+
+    When Find found nothing missing the ranking is not run: the table, probe table and design
+    are written empty, and the report and record say why.
+
+    Parameters
+    ----------
+    model_paths : mapping
+        Observable -> saved surrogate of the current model.
+    experiment_path : path
+        The experiment file with the measurements.
+    config : mapping
+        The validated configuration.
+    find_record_path : path
+        Record of the Find step (``missing``, ``verdict``, ``point``).
+    probe_files : iterable of path
+        ``bulk.csv`` of every probe run (none when nothing is missing).
+    table_path, markdown_path, record_path : path
+        Ranking table (CSV), report (markdown) and record (JSON) to write.
+    probes_path : path
+        All probe-run rows (CSV) to write.
+    design_path : path
+        Extended design of the named effect (CSV; only the header when none is named).
+
+    Returns
+    -------
+    RankingResult or None
+        None when the ranking was not run.
+    """
+    settings = config["discrepancy"]
+    find_rec = json.loads(Path(find_record_path).read_text())
+    if not find_rec["missing"]:
+        empty = pd.DataFrame(columns=["rank", "candidate", "status"])
+        empty.to_csv(table_path, index=False)
+        Path(markdown_path).write_text(
+            ranking_markdown(empty, None, 0, 0.0, verdict=find_rec["verdict"])
+        )
+        record = {"winner": None, "ran": False, "reason": find_rec["verdict"], "ranking": []}
+        Path(record_path).write_text(json.dumps(record, indent=2) + "\n")
+        _empty(design_path, ["case_id"])
+        _empty(probes_path, ["case_id"])
+        return None
+    experiment = load_experiment(experiment_path)
+    runs = read_runs(probe_files)
+    runs.to_csv(probes_path, index=False, float_format="%.8g")
+    result = rank(model_paths, experiment, config, runs, find_rec["point"])
+    result.table.to_csv(table_path, index=False, float_format="%.6g")
+    Path(markdown_path).write_text(
+        ranking_markdown(
+            result.table,
+            result.winner.name if result.winner else None,
+            len(result.find.observations),
+            float(settings["min_delta_bic"]),
+            float(settings["min_explained"]),
+            result.notes,
+        )
+    )
+    if result.winner is not None:
+        ext = settings["extended"]
+        design = extended_design(config, result.winner, int(ext["n"]), int(ext["seed"]))
+        design.to_csv(design_path, index=False, float_format="%.12g")
+    else:
+        _empty(design_path, ["case_id"])
+    Path(record_path).write_text(json.dumps(ranking_record(result), indent=2) + "\n")
+    write_sidecar(record_path, config)
+    return result

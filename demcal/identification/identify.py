@@ -1,0 +1,134 @@
+"""Identification of a material from its measurements: screen the candidate grid with the trained
+surrogates and write Table 5, the valid sets, Figs. 6-9, the identified parameter set and its
+LIGGGHTS material block.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from demcal.core.experiments import load_experiment
+from demcal.core.provenance import write_sidecar
+from demcal.decks.material_block import material_block_text
+from demcal.identification.calibration import CalibrationResult, calibrate, write_valid_sets
+from demcal.identification.figures import box_plot_normalised, cor_density_plot, note_figure
+from demcal.identification.statistics import table5_markdown, write_table5_csv
+from demcal.surrogates.training import load_surrogate
+
+#: Box-plot figures: file key -> (group of valid sets, title).
+BOX_PLOT_FIGURES = {
+    "fig6": ("SSC", "Fig. 6: shear cell"),
+    "fig8": ("AoR", "Fig. 8: angle of repose"),
+    "fig9": ("SSC & AoR", "Fig. 9: shear cell and angle of repose"),
+}
+
+
+@dataclass(frozen=True)
+class IdentificationFiles:
+    """The files the identification writes (the valid sets go beside ``table5``).
+
+    Attributes
+    ----------
+    table5, table5_csv : str or Path
+        Table 5 as markdown (with a heading and the screening summary) and as CSV.
+    identified : str or Path
+        JSON record of the identified set (group, valid counts, per-parameter statistics), with
+        a provenance sidecar ``<identified>.json``.
+    material : str or Path
+        LIGGGHTS material block of the identified mean parameters.
+    fig6, fig7, fig8, fig9 : str or Path
+        Figures (PNG) of the valid sets; a note figure where a group has none.
+    """
+
+    table5: str | Path
+    table5_csv: str | Path
+    identified: str | Path
+    material: str | Path
+    fig6: str | Path
+    fig7: str | Path
+    fig8: str | Path
+    fig9: str | Path
+
+
+def identify(
+    models: Mapping[str, str | Path],
+    experiment_file: str | Path,
+    screening: Mapping[str, Any],
+    constants: Mapping[str, Mapping[str, float]],
+    config: Mapping[str, Any],
+    files: IdentificationFiles,
+) -> CalibrationResult:
+    """Screen the candidate grid against the measurements and write every identification file.
+
+    Parameters
+    ----------
+    models : mapping of str to path
+        Bulk value (``mu_psh``, ``mu_sh``, ``rho_b``, ``aor``) -> saved network (``model.pt``
+        with its sidecar).
+    experiment_file : path
+        The measured bulk values (``config/experiments/*.yaml``).
+    screening : mapping
+        The ``screening`` config section (axes, seed, chunk_size, threads, tolerance).
+    constants : mapping
+        Bulk value -> network inputs held constant (e.g. the test's dCylDp).
+    config : mapping
+        The validated configuration (sidecar and material block).
+    files : IdentificationFiles
+        Where to write.
+
+    Returns
+    -------
+    CalibrationResult
+        Valid sets per group, Table 5 and the identified set.
+    """
+    surrogates = {name: load_surrogate(path) for name, path in models.items()}
+    experiment = load_experiment(experiment_file)
+    result = calibrate(surrogates, experiment, screening, constants)
+    write_valid_sets(result, Path(files.table5).parent)
+    text = (
+        f"# Table 5: valid parameter sets for {experiment.material}\n\n"
+        f"{result.n_total} candidate sets screened in {result.elapsed_s:.2f} s; tolerance "
+        f"{screening['tolerance']:.0%}.\n\n"
+    )
+    text += table5_markdown(result.table5) if len(result.table5) else "No measurement to match.\n"
+    Path(files.table5).write_text(text + "\n")
+    write_table5_csv(result.table5, files.table5_csv)
+    _write_figures(result, files)
+    record = {
+        "group": result.identified_group,
+        "n_valid": {g: len(v) for g, v in result.valid.items()},
+        "n_total": result.n_total,
+        "parameters": result.identified,
+    }
+    Path(files.identified).write_text(json.dumps(record, indent=2) + "\n")
+    write_sidecar(files.identified, dict(config), seed=int(screening["seed"]))
+    if result.identified:
+        means = {k: v["mean"] for k, v in result.identified.items()}
+        block = material_block_text(
+            means,
+            dict(config),
+            f"identified ({result.identified_group}) mean parameters for {experiment.material}",
+        )
+    else:
+        block = f"# no parameter set of the grid matches {experiment.material}\n"
+    Path(files.material).write_text(block)
+    return result
+
+
+def _write_figures(result: CalibrationResult, files: IdentificationFiles) -> None:
+    """Figs. 6, 8, 9 (box plots) and Fig. 7 (COR density), or a note where a group is empty."""
+    for key, (group, title) in BOX_PLOT_FIGURES.items():
+        valid = result.valid.get(group)
+        if valid is not None and len(valid):
+            box_plot_normalised(valid, getattr(files, key), title)
+        else:
+            note_figure(getattr(files, key), f"{title}: no valid sets or no measurement")
+    ssc = result.valid.get("SSC")
+    if ssc is not None and len(ssc):
+        cor_density_plot(ssc, result.axes, files.fig7, title="Fig. 7: shear cell")
+    else:
+        note_figure(files.fig7, "Fig. 7: no valid shear-cell sets or no measurement")

@@ -1,0 +1,47 @@
+"""The decks the fuzzer mutates: the tiny profile's shear cell, angle of repose and chute cooler."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from demcal.application.chute_cooler.deck import DECK_NAME as CHUTE_DECK
+from demcal.application.chute_cooler.deck import render_chute_cooler
+from demcal.core.config import load_config
+from demcal.robustness.mutation import BaseDeck
+from demcal.virtual_tests.deck import DECK_NAMES, render_case
+
+
+def render_base_decks(work_dir: Path, config: Path | None = None) -> list[BaseDeck]:
+    """Render the tiny shear cell, angle of repose and chute cooler decks into ``work_dir``.
+
+    Parameters
+    ----------
+    work_dir : Path
+        Directory that receives one sub-directory per deck (created if missing).
+    config : Path, optional
+        Configuration file; default ``config/tiny.yaml`` of the project.
+
+    Returns
+    -------
+    list of BaseDeck
+        The three decks, in the order shear cell, angle of repose, chute cooler.
+    """
+    root = Path(__file__).resolve().parents[2]
+    config = config or root / "config" / "tiny.yaml"
+    cfg = load_config(config)
+    base = {
+        "case_id": "fuzz",
+        "coefficientFriction": 0.3,
+        "coefficientRollingFriction": 0.1,
+        "coefficientRestitution": 0.6,
+        "density": 2500.0,
+    }
+    stress = cfg["shear_cell"]["normal_stresses"][0]
+    decks = []
+    render_case("shear_cell", {**base, "normal_stress": stress, "P": 0.8}, cfg, work_dir / "shear")
+    decks.append(BaseDeck("shear_cell", work_dir / "shear", DECK_NAMES["shear_cell"]))
+    render_case("angle_of_repose", base, load_config(config), work_dir / "aor")
+    decks.append(BaseDeck("angle_of_repose", work_dir / "aor", DECK_NAMES["angle_of_repose"]))
+    render_chute_cooler(load_config(config), work_dir / "chute")
+    decks.append(BaseDeck("chute_cooler", work_dir / "chute", CHUTE_DECK))
+    return decks

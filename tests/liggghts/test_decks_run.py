@@ -1,0 +1,179 @@
+"""LIGGGHTS 3.8 runs every deck the project renders, and the project's readers parse what it
+writes into bulk values.
+
+The decks are rendered from ``config/tiny.yaml`` exactly as the workflow renders them: the shear
+cell in both cycle modes (two load conditions each, to keep the runs short), single load
+conditions (a ``P`` column) with cohesion and wall friction and without rolling friction, the
+angle of repose and the chute cooler; one shear cell runs on two MPI ranks. Each run must exit
+with 0, print no WARNING except those in ``conftest.ALLOWED_WARNINGS``, and give finite bulk
+values in physical ranges.
+
+Typical values on LIGGGHTS (tiny, rho_p = 2500 kg/m^3): mu_psh 0.4-1.2, mu_sh 0.6-1.5, rho_b
+1150-1450 kg/m^3, angle of repose about 19 deg, solid fraction of the analysed chute-cooler box
+about 0.5. About 1.5 minutes on one core, plus the two-rank run (10-60 s, depending on how busy the
+cores are).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from demcal.application.chute_cooler.analysis import analyse_run, index_summary, vtk_steps
+from demcal.application.chute_cooler.deck import DECK_NAME as CHUTE_DECK
+from demcal.application.chute_cooler.deck import render_chute_cooler
+from demcal.bulk.values import extract
+from demcal.core.config import load_config
+from demcal.engine_io.fix_output import read_print_file
+from demcal.engine_io.vtk_file import read_vtk_particles
+from demcal.virtual_tests.deck import DECK_NAMES, render_case
+
+from .conftest import LiggghtsRun, run_liggghts, unexpected_warnings
+
+pytestmark = pytest.mark.liggghts
+
+ROOT = Path(__file__).resolve().parents[2]
+DENSITY = 2500.0
+BASE = {
+    "case_id": "c0001",
+    "coefficientFriction": 0.3,
+    "coefficientRollingFriction": 0.1,
+    "coefficientRestitution": 0.6,
+    "density": DENSITY,
+}
+STRESS = 2029.0  # the tiny profile's pre-shear stress, Pa
+TWO_CYCLES = [0.6, 1.0]
+
+# name: (test, case row, configuration overrides per section)
+SHEAR_CASES: dict[str, tuple[dict[str, Any], dict[str, dict[str, Any]]]] = {
+    "return": (
+        {**BASE, "normal_stress": STRESS},
+        {"shear_cell": {"cycles": "return", "P": TWO_CYCLES}},
+    ),
+    "alternate": (
+        {**BASE, "normal_stress": STRESS},
+        {"shear_cell": {"cycles": "alternate", "P": TWO_CYCLES}},
+    ),
+    "cohesion_wall_friction": (
+        {
+            **BASE,
+            "normal_stress": STRESS,
+            "P": 0.8,
+            "cohesionEnergyDensity": 5000.0,
+            "wallFriction": 0.5,
+        },
+        {},
+    ),
+    "no_rolling_friction": (
+        {**BASE, "normal_stress": STRESS, "P": 0.8},
+        {"material": {"rolling_friction": False}},
+    ),
+}
+
+
+def settings(overrides: dict[str, dict[str, Any]] | None = None) -> dict[str, Any]:
+    cfg = load_config(ROOT / "config" / "tiny.yaml")
+    for section, values in (overrides or {}).items():
+        cfg[section].update(values)
+    return cfg
+
+
+def check_clean_run(run: LiggghtsRun) -> None:
+    """Exit 0, a finished last run, and no WARNING but the allowed ones (screen and log)."""
+    assert run.returncode == 0, run.describe()
+    assert "ERROR" not in run.output, run.describe()
+    assert "Loop time of" in run.log(), run.describe()
+    unexpected = unexpected_warnings(run.output) + unexpected_warnings(run.log())
+    assert not unexpected, "LIGGGHTS warned:\n" + "\n".join(sorted(set(unexpected)))
+
+
+def check_shear_values(table: pd.DataFrame, expected_p: list[float]) -> None:
+    assert table["P"].tolist() == expected_p
+    assert (table["status"] == "ok").all()
+    for key in ("mu_psh", "mu_sh", "rho_b"):
+        assert np.isfinite(table[key].to_numpy()).all(), table
+    assert ((table["mu_psh"] > 0.0) & (table["mu_psh"] < 1.5)).all(), table
+    assert ((table["mu_sh"] > 0.0) & (table["mu_sh"] < 1.5)).all(), table
+    # A granular bed: solid fraction between a loose (cohesive) and a dense random packing.
+    fraction = table["rho_b"] / DENSITY
+    assert ((fraction > 0.4) & (fraction < 0.7)).all(), table
+
+
+def check_shear_snapshot(case_dir: Path) -> None:
+    """The VTK snapshot LIGGGHTS writes at the end of the first pre-shear reads with pyvista."""
+    vtk = read_vtk_particles(case_dir / "shear_preshear_end.vtk", arrays=["radius", "v"])
+    assert 300 < len(vtk.points) < 2000
+    assert vtk.arrays["v"].reshape(-1, 3).shape == vtk.points.shape
+    radius = float(settings()["particles"]["radius"])
+    assert np.allclose(vtk.arrays["radius"], radius, rtol=1e-5)
+
+
+@pytest.mark.parametrize("name", list(SHEAR_CASES))
+def test_shear_cell_deck_runs(name: str, tmp_path: Path) -> None:
+    case, overrides = SHEAR_CASES[name]
+    cfg = settings(overrides)
+    render_case("shear_cell", case, cfg, tmp_path)
+    run = run_liggghts(tmp_path, DECK_NAMES["shear_cell"])
+    check_clean_run(run)
+    expected_p = [case["P"]] if "P" in case else list(cfg["shear_cell"]["P"])
+    check_shear_values(extract("shear_cell", tmp_path), expected_p)
+    check_shear_snapshot(tmp_path)
+
+
+def test_shear_cell_deck_runs_on_two_mpi_ranks(tmp_path: Path) -> None:
+    # A shorter settling and pre-shear (the readers still find their plateaus) keep the run
+    # short when the two ranks share busy cores.
+    cfg = settings({"shear_cell": {"settle_fall_times": 1.0, "preshear_travel": 0.25}})
+    render_case("shear_cell", {**BASE, "normal_stress": STRESS, "P": 0.8}, cfg, tmp_path)
+    run = run_liggghts(tmp_path, DECK_NAMES["shear_cell"], ranks=2)
+    check_clean_run(run)
+    assert re.search(r"(1 by 1 by 2|1 by 2 by 1|2 by 1 by 1) MPI processor grid", run.stdout)
+    check_shear_values(extract("shear_cell", tmp_path), [0.8])
+    check_shear_snapshot(tmp_path)
+
+
+def test_angle_of_repose_deck_runs(tmp_path: Path) -> None:
+    case = {**BASE, "coefficientRollingFriction": 0.2}
+    render_case("angle_of_repose", case, settings(), tmp_path)
+    run = run_liggghts(tmp_path, DECK_NAMES["angle_of_repose"])
+    check_clean_run(run)
+    row = extract("angle_of_repose", tmp_path).iloc[0]
+    assert row["status"] == "ok"
+    assert bool(row["settled"])
+    assert row["n_particles_heap"] > 800
+    for key in ("aor", "aor_mean_slices", "aor_fit"):
+        assert 8.0 < row[key] < 40.0, (key, row[key])
+    assert row["aor_sector_spread"] < 5.0
+    # LIGGGHTS' VTK dump (legacy format 5.1, velocities as one vector) carries the same heap.
+    vtk = read_vtk_particles(tmp_path / "heap.vtk", arrays=["radius", "c_cn"])
+    assert len(vtk.points) == row["n_particles_final"]
+
+
+def test_chute_cooler_deck_runs(tmp_path: Path) -> None:
+    cfg = settings()
+    record = render_chute_cooler(cfg, tmp_path)
+    run = run_liggghts(tmp_path, CHUTE_DECK)
+    check_clean_run(run)
+    table = read_print_file(tmp_path / record["files"]["table"], columns=["atoms", "mass"])
+    last = table.iloc[-1]
+    assert last["mass"] >= 0.9 * last["mass_inserted"]
+    result, rec, _ = analyse_run(tmp_path)
+    summary = index_summary(result, rec)
+    assert summary["particles_in_box"] > 50
+    assert 0.3 < summary["solid_fraction_of_box"] < 0.74
+    for key in ("segregation_index", "sorted_index", "normalised_index"):
+        assert summary[key] is not None and math.isfinite(summary[key]), (key, summary)
+    assert abs(summary["normalised_index"]) <= 1.0
+    # One VTK file per dump step (LIGGGHTS adds *_boundingBox_* files, which are not read).
+    setup = record["setup"]
+    steps = vtk_steps(tmp_path)
+    every = int(setup["vtk_every"])
+    assert [s for s, _ in steps] == list(range(0, int(setup["total_steps"]) + 1, every))
+    vtk = read_vtk_particles(steps[-1][1], arrays=["radius"])
+    assert len(vtk.points) == int(last["atoms"])
