@@ -41,12 +41,16 @@ __all__ = [
     "OPTIONAL_CONTACT_PARAMETERS",
     "PARAMETERS",
     "PARAMETER_LABELS",
+    "TESTS",
     "Interval",
     "Parameter",
     "closest_parameter",
     "out_of_bounds",
     "unknown_parameter",
 ]
+
+#: The virtual bulk tests, by the name used in case directories, configuration and datasets.
+TESTS: tuple[str, ...] = ("shear_cell", "angle_of_repose")
 
 #: Gravitational acceleration of every deck, set-up and readout, m/s^2 (acting along -z).
 GRAVITY = 9.81

@@ -17,7 +17,6 @@ from demcal.core.provenance import write_sidecar
 from demcal.design.build import build_design
 from demcal.design.table import write_design_table
 
-TESTS = ("shear_cell", "angle_of_repose")
 _SHEAR_KEY = re.compile(r"[A-Za-z0-9]+_s(?P<s>\d+)(_p(?P<p>\d+))?")
 
 # Keys of the design config section that each kind of design reads.

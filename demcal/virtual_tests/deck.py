@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from demcal.core.parameters import CONTACT_PARAMETERS, GRAVITY
+from demcal.core.parameters import CONTACT_PARAMETERS, GRAVITY, TESTS
 from demcal.decks.case_validation import ValidationRules, validate_case
 from demcal.decks.mesh_primitives import annulus, cylinder_shell, disc
 from demcal.decks.render import render_deck, write_case_directory
@@ -39,7 +39,6 @@ __all__ = [
     "render_case",
 ]
 
-TESTS = ("shear_cell", "angle_of_repose")
 DECK_NAMES = {"shear_cell": "in.shear_cell", "angle_of_repose": "in.angle_of_repose"}
 
 # Output files the decks write (relative to the case directory).

@@ -1,6 +1,6 @@
 # Shared set-up: validated configuration, the case list and output locations.
+from demcal.core.parameters import TESTS
 from demcal.design.cases import (
-    TESTS,
     case_ids,
     case_row,
     design_from_config,
