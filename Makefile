@@ -10,7 +10,7 @@ ENGINE_SOURCES := $(shell find dem_engine/src dem_engine/CMakeLists.txt -type f 
 CORES ?= all
 SNAKEMAKE_ARGS ?=
 
-.PHONY: setup sysdeps engine run test lint bench docs clean
+.PHONY: setup sysdeps engine run test lint bench convergence docs clean
 
 setup: $(PY_STAMP) sysdeps engine
 
@@ -49,6 +49,12 @@ lint: setup
 
 bench: setup
 	source $(VENV)/bin/activate && python dem_engine/bench/run_bench.py
+
+# Convergence study of the virtual tests at the quick profile (hours on 2 cores; resumable).
+CONVERGENCE_ARGS ?=
+convergence: setup
+	source $(VENV)/bin/activate && python scripts/convergence_study.py --config config/config.yaml \
+		--out results/convergence/quick $(CONVERGENCE_ARGS)
 
 # The configuration reference, generated from the schema (tests/unit/test_docs.py checks it).
 docs: $(PY_STAMP)

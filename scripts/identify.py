@@ -13,6 +13,7 @@ def main(snakemake) -> None:
             snakemake.params.constants,
             dict(snakemake.config),
             IdentificationFiles(**dict(snakemake.output.items())),
+            dataset=snakemake.input.dataset,
         )
         logger.info(
             "screened %d candidate sets in %.2f s; valid: %s",

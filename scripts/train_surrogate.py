@@ -24,6 +24,19 @@ def main(snakemake) -> None:
             sweep.selected_size,
             sweep.paper_rule_size,
         )
+        for method, row in trained.table4.iterrows():
+            logger.info(
+                "%s %s: test R^2 %.3g (%d sets), cross-validated R^2 %.3g, RMSE %.3g "
+                "(%d folds over %d sets)",
+                output,
+                method,
+                row["test_r2"],
+                row["test_sets"],
+                row["cv_r2"],
+                row["cv_rmse"],
+                row["cv_folds"],
+                row["cv_sets"],
+            )
 
 
 main(snakemake)  # noqa: F821

@@ -16,6 +16,7 @@ def main(snakemake) -> None:
             snakemake.output.table,
             commands=engines,
             threads=snakemake.params.threads,
+            identified=snakemake.input.identified,
         )
 
 

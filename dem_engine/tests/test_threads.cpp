@@ -1,5 +1,6 @@
-// Tests of how work is split between threads: the particle partition and the per-pair
-// "touching" flags of the neighbour list that let the pair loop skip the history of pairs apart.
+// Tests of how work is split between threads (the particle partition, balanced by the contacts
+// the neighbour list marks as touching at a build) and of the contact histories a neighbour
+// build keeps.
 #include <cstddef>
 #include <vector>
 
@@ -45,7 +46,9 @@ TEST_CASE("partition: every thread of a team covers its share exactly once") {
   for (int c : seen) CHECK_EQ(c, 1);
 }
 
-TEST_CASE("neighbour list: a rebuild keeps the history of touching pairs only") {
+TEST_CASE("neighbour list: a rebuild keeps the history of the pairs touching at the build") {
+  // As LIGGGHTS 3.8: what counts is the geometry at the build (the positions of the force
+  // evaluation that follows it), not the touching flag of the previous evaluation.
   dem::Particles p;
   dem::Domain box;
   box.boundary = {'f', 'f', 'f'};
@@ -59,12 +62,18 @@ TEST_CASE("neighbour list: a rebuild keeps the history of touching pairs only") 
   list.skin = 0.002;
   list.build(p, box);
   CHECK_EQ(list.pairs(), std::size_t{2});
-  // A fresh list has no history, so nothing is touching yet.
-  CHECK_EQ(list.touching[0] + list.touching[1], 0);
-  list.history[0] = 1e-6;  // the 1-2 contact has a tangential spring
-  list.touching[0] = 1;
-  // The 2-3 pair touched before and opened: its history is stale (kept until the build).
+  // The flags follow the geometry of the build; a fresh list has no history.
+  CHECK_EQ(static_cast<int>(list.touching[0]), 1);
+  CHECK_EQ(static_cast<int>(list.touching[1]), 0);
+  CHECK_EQ(list.history[0], 0.0);
+  CHECK_EQ(list.history[dem::kHistorySize], 0.0);
+
+  // 1-2 touch at the build: the spring is kept, even flagged apart at the last evaluation.
+  // 2-3 touched at the last evaluation but are apart at the build: the spring is dropped.
+  list.history[0] = 1e-6;
+  list.touching[0] = 0;
   list.history[dem::kHistorySize] = 2e-6;
+  list.touching[1] = 1;
   list.force_rebuild();
   list.build(p, box);
   CHECK_EQ(list.pairs(), std::size_t{2});
@@ -72,4 +81,45 @@ TEST_CASE("neighbour list: a rebuild keeps the history of touching pairs only") 
   CHECK_EQ(static_cast<int>(list.touching[1]), 0);
   CHECK_EQ(list.history[0], 1e-6);
   CHECK_EQ(list.history[dem::kHistorySize], 0.0);
+
+  // 2-3 opened earlier (flag 0, spring kept while in the list) and touch again at the build:
+  // the spring is resumed. 1-2 moved apart (still in the list): their spring is dropped.
+  list.history[dem::kHistorySize] = 3e-6;
+  list.touching[1] = 0;
+  p.x[0] = Vec3{-0.0015, 0.0, 0.0};
+  p.x[2] = Vec3{0.0385, 0.0, 0.0};
+  list.force_rebuild();
+  list.build(p, box);
+  CHECK_EQ(list.pairs(), std::size_t{2});
+  CHECK_EQ(static_cast<int>(list.touching[0]), 0);
+  CHECK_EQ(static_cast<int>(list.touching[1]), 1);
+  CHECK_EQ(list.history[0], 0.0);
+  CHECK_EQ(list.history[dem::kHistorySize], 3e-6);
+}
+
+TEST_CASE("neighbour list: after a reordering, histories follow the tags and the build geometry") {
+  dem::Particles p;
+  dem::Domain box;
+  box.boundary = {'f', 'f', 'f'};
+  box.lo = Vec3{-1, -1, -1};
+  box.hi = Vec3{1, 1, 1};
+  // 1-2 overlap, 2-3 are within the skin but apart.
+  p.add(1, 1, 1u, Vec3{0.0, 0.0, 0.0}, 0.01, 2500.0);
+  p.add(2, 1, 1u, Vec3{0.019, 0.0, 0.0}, 0.01, 2500.0);
+  p.add(3, 1, 1u, Vec3{0.0395, 0.0, 0.0}, 0.01, 2500.0);
+  dem::NeighborList list;
+  list.skin = 0.002;
+  list.build(p, box);
+  list.history[0] = 1e-6;                  // 1-2, touching
+  list.history[dem::kHistorySize] = 2e-6;  // 2-3, apart
+  list.touching[1] = 1;                    // 2-3 touched at the last evaluation
+  // Reversed order: tags 3, 2, 1. The pairs are now (3, 2) and (2, 1), listed from the
+  // particle of lower index, so the 1-2 history is seen from particle 2: its sign flips.
+  p.permute({2, 1, 0});
+  list.build(p, box);
+  CHECK_EQ(list.pairs(), std::size_t{2});
+  CHECK_EQ(static_cast<int>(list.touching[0]), 0);  // 3-2
+  CHECK_EQ(static_cast<int>(list.touching[1]), 1);  // 2-1
+  CHECK_EQ(list.history[0], 0.0);
+  CHECK_EQ(list.history[dem::kHistorySize], -1e-6);
 }

@@ -11,11 +11,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import pandas as pd
+
 from demcal.core.experiments import load_experiment
 from demcal.core.provenance import write_sidecar
 from demcal.decks.material_block import material_block_text
 from demcal.identification.calibration import CalibrationResult, calibrate, write_valid_sets
 from demcal.identification.figures import box_plot_normalised, cor_density_plot, note_figure
+from demcal.identification.reachability import reach_of_measurements, reach_statement
 from demcal.identification.statistics import table5_markdown, write_table5_csv
 from demcal.surrogates.training import load_surrogate
 
@@ -61,6 +64,7 @@ def identify(
     constants: Mapping[str, Mapping[str, float]],
     config: Mapping[str, Any],
     files: IdentificationFiles,
+    dataset: str | Path | None = None,
 ) -> CalibrationResult:
     """Screen the candidate grid against the measurements and write every identification file.
 
@@ -79,6 +83,10 @@ def identify(
         The validated configuration (sidecar and material block).
     files : IdentificationFiles
         Where to write.
+    dataset : path, optional
+        The bulk-value dataset the networks were trained on; when given, the first line of
+        Table 5 and the identified-set record say whether every measured value lies within
+        the range of its DEM runs (:mod:`demcal.identification.reachability`).
 
     Returns
     -------
@@ -89,7 +97,12 @@ def identify(
     experiment = load_experiment(experiment_file)
     result = calibrate(surrogates, experiment, screening, constants)
     write_valid_sets(result, Path(files.table5).parent)
-    text = (
+    reach = None
+    if dataset is not None:
+        tol = float(screening["tolerance"])
+        reach = reach_of_measurements(pd.read_csv(dataset), experiment, tol)
+    statement = reach_statement(reach, experiment.material) + "\n\n" if reach else ""
+    text = statement + (
         f"# Table 5: valid parameter sets for {experiment.material}\n\n"
         f"{result.n_total} candidate sets screened in {result.elapsed_s:.2f} s; tolerance "
         f"{screening['tolerance']:.0%}.\n\n"
@@ -104,6 +117,9 @@ def identify(
         "n_total": result.n_total,
         "parameters": result.identified,
     }
+    if reach is not None:
+        record["reachable"] = all(r.reachable for r in reach)
+        record["reach"] = reach_statement(reach, experiment.material)
     Path(files.identified).write_text(json.dumps(record, indent=2) + "\n")
     write_sidecar(files.identified, dict(config), seed=int(screening["seed"]))
     if result.identified:

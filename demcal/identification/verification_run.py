@@ -63,6 +63,7 @@ def write_verification_table(
     markdown: str | Path,
     commands: Mapping[str, str] | None = None,
     threads: int | None = None,
+    identified: str | Path | None = None,
 ) -> pd.DataFrame:
     """Compare the verification runs of every engine with the measurements and each other;
     write the table as CSV and as text.
@@ -81,6 +82,9 @@ def write_verification_table(
         Command template of each engine, listed above the text table.
     threads : int, optional
         Threads or MPI ranks of each run, listed with the commands.
+    identified : path, optional
+        The identified-set record; its reachability verdict (``reach``, written by
+        :func:`demcal.identification.identify.identify`) becomes the first line of the text.
 
     Returns
     -------
@@ -95,6 +99,10 @@ def write_verification_table(
     table = verification_table(runs, load_experiment(experiment_file), float(tolerance))
     table.to_csv(csv, index=False)
     lines = ["# Verification: DEM at the identified mean set vs measurement", ""]
+    if identified is not None:
+        verdict = json.loads(Path(identified).read_text()).get("reach")
+        if verdict:
+            lines = [verdict, "", *lines]
     lines.append("Engines (columns dem_<engine>, deviation_<engine> = |1 - dem/measured|):")
     for engine in runs:
         command = (commands or {}).get(engine)

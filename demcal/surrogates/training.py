@@ -1,26 +1,35 @@
-"""Training the surrogate of one bulk value: the hidden-size sweep, the baselines, Table 4."""
+"""Training the surrogate of one bulk value: the hidden-size sweep, the baselines, the
+cross-validation by parameter set and Table 4."""
 
 import json
+import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from demcal.bulk.dataset import PARAMETERS, usable
 from demcal.core.provenance import write_sidecar
-from demcal.surrogates.baselines import bayesian_linear_regression, gaussian_process_regression
+from demcal.surrogates.baselines import baseline_predictions
+from demcal.surrogates.cross_validation import (
+    METHODS,
+    CrossValidation,
+    cross_validate,
+    effective_folds,
+    set_counts,
+)
 from demcal.surrogates.data_split import split_groups
 from demcal.surrogates.figures import parity_plot, r2_vs_hidden_size
-from demcal.surrogates.hidden_size_sweep import (
-    SweepResult,
-    select_by_test_r2,
-    select_by_validation,
-    sweep_hidden_sizes,
-)
-from demcal.surrogates.metrics import method_comparison_table, regression_metrics, to_markdown
+from demcal.surrogates.hidden_size_sweep import SweepResult, sweep_hidden_sizes
+from demcal.surrogates.metrics import regression_metrics
 from demcal.surrogates.network import MLPSurrogate
+from demcal.surrogates.table4 import SPLIT_PARTS, method_rows, section_markdown
+from demcal.surrogates.table4 import write_table4_document as write_table4_document
+
+_log = logging.getLogger(__name__)
 
 #: Candidate inputs per bulk value (paper section "Artificial Neural Networks").
 SHEAR_INPUTS = (*PARAMETERS, "normal_stress", "P")
@@ -37,7 +46,6 @@ TEST_OF = {
     "rho_b": "shear_cell",
     "aor": "angle_of_repose",
 }
-METHODS = ("Bayesian", "Gaussian", "ANN")
 
 
 def varying_features(data: pd.DataFrame, candidates: Sequence[str]) -> list[str]:
@@ -47,11 +55,33 @@ def varying_features(data: pd.DataFrame, candidates: Sequence[str]) -> list[str]
 
 @dataclass
 class TrainedSurrogate:
+    """Outcome of :func:`train_output`.
+
+    Attributes
+    ----------
+    output : str
+        The bulk value.
+    features : list of str
+        The network's ordered inputs.
+    sweep : SweepResult
+        The hidden-size sweep on the single split; ``sweep.model`` is the saved network.
+    table4 : pandas.DataFrame
+        The Table 4 rows (:func:`demcal.surrogates.table4.method_rows`), one per method.
+    n_samples : int
+        Usable rows.
+    cv : CrossValidation or None
+        The cross-validation by parameter set, None when off or skipped.
+    cv_note : str
+        Why the fold count differs from ``surrogate.cv_folds`` (empty if it does not).
+    """
+
     output: str
     features: list[str]
     sweep: SweepResult
     table4: pd.DataFrame
     n_samples: int
+    cv: CrossValidation | None = None
+    cv_note: str = ""
 
 
 def train_output(
@@ -59,20 +89,32 @@ def train_output(
 ) -> TrainedSurrogate:
     """Train and evaluate the network of ``output`` and its baselines; write all artifacts.
 
+    The saved network comes from the hidden-size sweep on one split by parameter set
+    (``surrogate.split``): trained on the training sets, early-stopped on the generalisation
+    sets, scored on the test sets. The same network size and settings, and the baselines, are
+    then cross-validated with ``surrogate.cv_folds`` folds by parameter set
+    (:func:`demcal.surrogates.cross_validation.cross_validate`); a fold count larger than the
+    usable sets allow is clamped with a logged warning
+    (:func:`demcal.surrogates.cross_validation.effective_folds`).
+
     Parameters
     ----------
     data : DataFrame
-        The tidy bulk dataset.
+        The tidy bulk dataset (one row per case and load condition, ``design_id`` naming the
+        parameter set).
     output : {"mu_psh", "mu_sh", "rho_b", "aor"}
     settings : mapping
-        The ``surrogate`` config section.
+        The ``surrogate`` config section (``hidden_sizes``, ``split``, ``seed``,
+        ``max_epochs``, ``patience``, ``cv_folds``).
     out_dir : path
-        Receives model.pt (+ .json sidecar), sweep.csv, table4.csv/.md and the figures.
+        Receives model.pt (+ .json sidecar), sweep.csv, table4.csv/.md, cv_folds.csv (one row
+        per fold and method; only a header without cross-validation) and the figures.
 
     Raises
     ------
     ValueError
-        When fewer than 6 usable samples or 3 parameter sets exist (no meaningful split).
+        When fewer than 6 usable samples or 3 parameter sets exist (no meaningful split), or
+        ``cv_folds`` is 1 or negative.
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -84,34 +126,45 @@ def train_output(
     features = varying_features(rows, INPUTS[output])
     X = rows[features].to_numpy(dtype=float)
     y = rows[output].to_numpy(dtype=float)
+    groups = rows["design_id"].astype(str).to_numpy()
     seed = int(settings["seed"])
+    n_folds, cv_note = effective_folds(settings["cv_folds"], int(np.unique(groups).size))
+    if cv_note:
+        _log.warning("%s: %s", output, cv_note)
     # Split by parameter set: the load conditions of one set are not independent samples.
-    train, val, test = split_groups(rows["design_id"].to_numpy(), seed, tuple(settings["split"]))
+    train, val, test = split_groups(groups, seed, tuple(settings["split"]))
     lo, hi = settings["hidden_sizes"]
+    mlp_params = {"max_epochs": int(settings["max_epochs"]), "patience": int(settings["patience"])}
     sweep = sweep_hidden_sizes(
-        X,
-        y,
-        train,
-        val,
-        test,
-        sizes=range(lo, hi + 1),
-        seed=seed,
-        max_epochs=int(settings["max_epochs"]),
-        patience=int(settings["patience"]),
+        X, y, train, val, test, sizes=range(lo, hi + 1), seed=seed, **mlp_params
     )
     sweep.table.to_csv(out_dir / "sweep.csv", index=False)
-    predictions = {"ANN": sweep.model.predict(X[test])}
-    blr = bayesian_linear_regression().fit(X[train], y[train])
-    predictions["Bayesian"] = blr.predict(X[test])
-    gp = gaussian_process_regression(seed).fit(X[train], y[train])
-    predictions["Gaussian"] = gp.predict(X[test])
-    table4 = method_comparison_table({m: (y[test], predictions[m]) for m in METHODS})
-    table4.to_csv(out_dir / "table4.csv")
-    (out_dir / "table4.md").write_text(
-        f"Table 4 ({output}): test-set comparison, {len(test)} of {len(rows)} samples\n\n"
-        + to_markdown(table4, float_format=".3g")
-        + "\n"
+    predictions = baseline_predictions(X[train], y[train], X[test], seed)
+    predictions["ANN"] = sweep.model.predict(X[test])
+    test_metrics = {m: regression_metrics(y[test], predictions[m]) for m in METHODS}
+    cv = None
+    if n_folds:
+        cv = cross_validate(
+            X,
+            y,
+            groups,
+            n_folds,
+            hidden_size=sweep.selected_size,
+            seed=seed,
+            split=tuple(settings["split"]),
+            **mlp_params,
+        )
+        cv_table = cv.folds
+    else:
+        cv_table = pd.DataFrame(columns=["fold", "method"])
+    cv_table.to_csv(out_dir / "cv_folds.csv", index=False, float_format="%.6g")
+    parts = (train, val, test)
+    counts = {name: set_counts(groups, part) for name, part in zip(SPLIT_PARTS, parts, strict=True)}
+    table4 = method_rows(
+        output, counts, test_metrics, cv, cv_note, float(np.mean(y)), sweep.selected_size
     )
+    table4.to_csv(out_dir / "table4.csv", float_format="%.6g")
+    (out_dir / "table4.md").write_text(section_markdown(output, table4, sweep.table))
     for method in METHODS:
         parity_plot(
             y[test],
@@ -120,7 +173,15 @@ def train_output(
             out_dir / f"parity_{method.lower()}.png",
         )
     r2_vs_hidden_size(sweep.table, out_dir / "r2_vs_hidden_size.png")
-    ann = regression_metrics(y[test], predictions["ANN"])
+    cv_metrics = {}
+    if cv is not None:
+        ann = table4.loc["ANN"]
+        cv_metrics = {
+            "folds": int(ann["cv_folds"]),
+            "sets": int(ann["cv_sets"]),
+            "rows": int(ann["cv_rows"]),
+            **{k: float(ann[f"cv_{k}"]) for k in ("r2", "rmse", "mae", "mse")},
+        }
     sweep.model.save(
         out_dir / "model.pt",
         metadata={
@@ -128,12 +189,14 @@ def train_output(
             "features": features,
             "n_samples": len(rows),
             "split_sizes": [len(train), len(val), len(test)],
+            "split_sets": [counts[p][0] for p in SPLIT_PARTS],
             "selected_size": int(sweep.selected_size),
             "paper_rule_size": int(sweep.paper_rule_size),
-            "test_metrics": {k: float(v) for k, v in ann.items()},
+            "test_metrics": {k: float(v) for k, v in test_metrics["ANN"].items()},
+            "cv_metrics": cv_metrics,
         },
     )
-    return TrainedSurrogate(output, features, sweep, table4, len(rows))
+    return TrainedSurrogate(output, features, sweep, table4, len(rows), cv, cv_note)
 
 
 def train_from_dataset(
@@ -162,36 +225,6 @@ def train_from_dataset(
     trained = train_output(pd.read_csv(dataset), output, settings, Path(model).parent)
     write_sidecar(Path(model).parent / "table4.csv", config, seed=int(settings["seed"]))
     return trained
-
-
-def write_table4_document(
-    outputs: Sequence[str],
-    tables: Sequence[str | Path],
-    sweeps: Sequence[str | Path],
-    markdown: str | Path,
-) -> None:
-    """Gather Table 4 of every bulk value and its hidden-size choices into one markdown file.
-
-    Parameters
-    ----------
-    outputs : sequence of str
-        The bulk values, in document order.
-    tables, sweeps : sequence of path
-        ``table4.csv`` and ``sweep.csv`` of each bulk value, in the order of ``outputs``.
-    markdown : path
-        The document.
-    """
-    parts = ["# Table 4: regression methods compared on the test set\n"]
-    for name, table, sweep in zip(outputs, tables, sweeps, strict=True):
-        t4 = pd.read_csv(table, index_col=0)
-        sw = pd.read_csv(sweep)
-        parts.append(
-            f"## {name}\n\nNetwork size chosen by generalisation-set error: "
-            f"{select_by_validation(sw)} hidden neurons; the paper's rule (best test R^2) "
-            f"would pick {select_by_test_r2(sw)}.\n\n{to_markdown(t4, float_format='.3g')}\n"
-        )
-    with open(markdown, "w") as fh:
-        fh.write("\n".join(parts))
 
 
 def load_surrogate(path: str | Path) -> tuple[MLPSurrogate, list[str]]:

@@ -44,10 +44,13 @@ DECK_NAMES = {"shear_cell": "in.shear_cell", "angle_of_repose": "in.angle_of_rep
 # Output files the decks write (relative to the case directory).
 SHEAR_FILES = {
     "lower": "meshes/shear_lower.stl",
+    "lower_flange": "meshes/shear_lower_flange.stl",
     "upper": "meshes/shear_upper.stl",
+    "upper_flange": "meshes/shear_upper_flange.stl",
     "lid": "meshes/shear_lid.stl",
     "table": "shear_cell.txt",
     "snapshot": "shear_preshear_end.vtk",
+    "contacts": "contacts.dump",
 }
 REPOSE_FILES = {
     "plate": "meshes/aor_plate.stl",
@@ -119,16 +122,16 @@ def _shear_meshes(s: ShearCellSetup) -> dict[str, np.ndarray]:
     n = s.n_segments
     r = s.radius
     outer = r + s.flange_width
+    # The flanges are meshes of their own: the readout separates the force carried across the
+    # shear plane by the bulk from the friction and load of the flanges on the crescents.
     return {
         "lower": merge(
             disc(r, 0.0, n, normal_up=True),
             cylinder_shell(r, 0.0, s.z_shear, n, normals="inward"),
-            annulus(r, outer, s.z_shear, n, normal_up=True),
         ),
-        "upper": merge(
-            cylinder_shell(r, s.z_shear, s.wall_top, n, normals="inward"),
-            annulus(r, outer, s.z_shear, n, normal_up=False),
-        ),
+        "lower_flange": annulus(r, outer, s.z_shear, n, normal_up=True),
+        "upper": cylinder_shell(r, s.z_shear, s.wall_top, n, normals="inward"),
+        "upper_flange": annulus(r, outer, s.z_shear, n, normal_up=False),
         # The lid is placed by the deck (`move`) just above the settled bed.
         "lid": disc(r, 0.0, n, normal_up=False),
     }

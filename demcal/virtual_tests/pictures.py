@@ -6,6 +6,8 @@
 * :func:`shear_cell_picture`: the shear cell at the end of the first pre-shear, cut in half along
   the shear direction, particles coloured by speed (the shear zone shows), the walls at their
   positions of that moment (lower part offset, lid height from the print file).
+* :func:`mu_series_figure`: mu(t) of a shear-cell run (matplotlib), pre-shear and shear in two
+  colours, with the steady windows the readout averaged and their means.
 """
 
 from __future__ import annotations
@@ -13,16 +15,24 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pyvista
+from matplotlib.figure import Figure
 
-from demcal.bulk.values import MissingOutputError, read_case_record
+from demcal.bulk.values import MissingOutputError, extract, read_case_record
 from demcal.engine_io.fix_output import read_print_file
 from demcal.engine_io.vtk_file import read_vtk_particles
 from demcal.virtual_tests.angle_of_repose.readout import angle_of_repose
+from demcal.virtual_tests.shear_cell.readout import (
+    PHASE_PRE_SHEAR,
+    PHASE_SHEAR,
+    REQUIRED_COLUMNS,
+    shear_stress_series,
+)
 
 pyvista.OFF_SCREEN = True
 
-__all__ = ["heap_picture", "shear_cell_picture"]
+__all__ = ["heap_picture", "mu_series_figure", "shear_cell_picture"]
 
 _WINDOW = (1400, 900)
 # Vertical colour bar on the right, clear of the heap and the cell.
@@ -190,12 +200,19 @@ def shear_cell_picture(case_dir: Path, png: Path) -> Path:
         clim=(0.0, 1.5 * float(setup["shear_speed"])),
         scalar_bar_args=_BAR | {"title": "particle speed (m/s)"},
     )
-    walls = {"lower": (travel, 0.0, 0.0), "upper": (0.0, 0.0, 0.0)}
-    colours = {"lower": "steelblue", "upper": "gray"}
+    walls = {
+        "lower": (travel, 0.0, 0.0),
+        "lower_flange": (travel, 0.0, 0.0),
+        "upper": (0.0, 0.0, 0.0),
+        "upper_flange": (0.0, 0.0, 0.0),
+    }
+    colours = {"lower": "steelblue", "lower_flange": "steelblue", "upper": "gray"}
     for name, offset in walls.items():
+        if name not in files:  # a case rendered before the flanges were meshes of their own
+            continue
         mesh = pyvista.read(str(_existing(case_dir, files[name]))).translate(offset, inplace=False)
         mesh = mesh.clip(normal=(0.0, -1.0, 0.0), origin=(0.0, 0.0, 0.0))
-        plotter.add_mesh(mesh, color=colours[name], opacity=0.25, show_edges=True)
+        plotter.add_mesh(mesh, color=colours.get(name, "gray"), opacity=0.25, show_edges=True)
     radius = float(setup["radius"])
     z_shear = float(setup["z_shear"])
     front = -1.1 * radius
@@ -224,4 +241,145 @@ def shear_cell_picture(case_dir: Path, png: Path) -> Path:
     png.parent.mkdir(parents=True, exist_ok=True)
     plotter.screenshot(str(png))
     plotter.close()
+    return png
+
+
+# Phases of the mu(t) figure: readout column suffix, print-file phase, label and colours (line
+# and shaded window, mean segment).
+_MU_PHASES = (
+    ("psh", PHASE_PRE_SHEAR, "pre-shear", "tab:blue", "navy"),
+    ("sh", PHASE_SHEAR, "shear", "tab:orange", "saddlebrown"),
+)
+
+
+def _mu_axes(figure: Figure, series: pd.DataFrame, values: pd.DataFrame, title: str) -> None:
+    """Draw mu(t) of the pre-shear and shear rows of ``series`` and the windows of ``values``.
+
+    The artists carry a ``gid`` (phase ``psh`` or ``sh``): ``series_<phase>_<cycle>`` for the
+    mu(t) line, ``window_<phase>_<cycle>`` for the shaded readout window and
+    ``mean_<phase>_<cycle>`` for the mean segment across it.
+    """
+    ax = figure.add_subplot()
+    shown = []
+    for key, phase, label, colour, _ in _MU_PHASES:
+        rows = series[series["phase"] == phase]
+        for k, (_, part) in enumerate(rows.groupby("cycle", sort=True)):
+            ax.plot(
+                part["time"],
+                part["mu"],
+                color=colour,
+                linewidth=0.9,
+                label=f"{label} (phase {phase})" if k == 0 else None,
+                gid=f"series_{key}_{int(part['cycle'].iloc[0])}",
+            )
+        shown.append(rows["mu"].to_numpy(dtype=np.float64))
+    means = []
+    for _, row in values.iterrows():
+        cycle = int(row["cycle"])
+        for key, _, label, colour, dark in _MU_PHASES:
+            start, end = float(row[f"{key}_t_start"]), float(row[f"{key}_t_end"])
+            mean = float(row[f"mu_{key}"])
+            if not (np.isfinite(start) and np.isfinite(end) and np.isfinite(mean)):
+                continue
+            means.append(mean)
+            first = cycle == int(values["cycle"].min())
+            ax.axvspan(
+                start,
+                end,
+                color=colour,
+                alpha=0.2,
+                linewidth=0,
+                label=f"{label} window averaged by the readout" if first else None,
+                gid=f"window_{key}_{cycle}",
+            )
+            ax.plot(
+                [start, end], [mean, mean], color=dark, linewidth=2.2, gid=f"mean_{key}_{cycle}"
+            )
+            verdict = "steady" if bool(row[f"steady_{key}"]) else "not steady"
+            ax.annotate(
+                f"{mean:.3f}\n{verdict}",
+                xy=(0.5 * (start + end), mean),
+                xytext=(0, 4),
+                textcoords="offset points",
+                ha="center",
+                va="bottom",
+                fontsize=7,
+                color=dark,
+                bbox={
+                    "boxstyle": "round,pad=0.15",
+                    "facecolor": "white",
+                    "edgecolor": "none",
+                    "alpha": 0.7,
+                },
+            )
+    finite = np.concatenate([*shown, np.asarray(means)])
+    finite = finite[np.isfinite(finite)]
+    if finite.size:
+        # Start-up spikes of a phase (tiny overlap area, lid not yet loaded) would flatten the
+        # plateaus; the top leaves room for the labels above the means.
+        top = max(float(np.percentile(finite, 99)), max(means, default=0.0))
+        ax.set_ylim(min(0.0, float(np.percentile(finite, 1))), 1.3 * top if top > 0 else 1.0)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("mu = tau / sigma (-)")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, linewidth=0.3, alpha=0.5)
+    # Outside the axes: the start of every phase (mu rising from 0) stays visible.
+    figure.legend(loc="outside lower center", ncols=4, fontsize=8, frameon=False)
+
+
+def mu_series_figure(case_dir: Path, png: Path) -> Path:
+    """mu(t) of a shear-cell run with the steady windows the readout averaged.
+
+    The pre-shear (phase 1) and shear (phase 3) rows of the print file are drawn in two colours
+    (mu from :func:`demcal.virtual_tests.shear_cell.readout.shear_stress_series` with the
+    geometry of ``case.json``). For every cycle the windows found by the readout
+    (:func:`demcal.bulk.values.extract`) are shaded, their mean ``mu_psh`` / ``mu_sh`` drawn as
+    a horizontal segment across the window and labelled with its value and whether the window
+    is steady.
+
+    Parameters
+    ----------
+    case_dir : Path
+        A shear-cell case directory after the engine run (``case.json`` and the print file
+        named in its ``files.table``).
+    png : Path
+        Output image; parent directories are created.
+
+    Returns
+    -------
+    Path
+        ``png``.
+
+    Raises
+    ------
+    MissingOutputError
+        If ``case.json`` or the print file is missing or truncated (names the file).
+    ValueError
+        If the case is not a shear-cell case or the print file is inconsistent (see
+        :func:`demcal.virtual_tests.shear_cell.readout.shear_stress_series`).
+    """
+    case_dir = Path(case_dir)
+    record = _record(case_dir, "shear_cell")
+    readout, setup = record["readout"], record["setup"]
+    table = read_print_file(
+        _existing(case_dir, record["files"]["table"]), columns=list(REQUIRED_COLUMNS)
+    )
+    series = shear_stress_series(
+        table,
+        float(readout["radius"]),
+        float(readout["z_floor"]),
+        float(readout["z_shear"]),
+        float(readout["gravity"]),
+    )
+    values = extract("shear_cell", case_dir)
+    p_values = ", ".join(f"{float(p):g}" for p in values["P"])
+    title = (
+        f"case {record['case_id']}: mu(t), normal stress "
+        f"{float(setup['normal_stress']):.0f} Pa, P = {p_values}"
+    )
+    figure = Figure(figsize=(10.0, 4.8), dpi=150, layout="constrained")
+    _mu_axes(figure, series, values, title)
+    png = Path(png)
+    png.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(png, dpi=figure.dpi)
     return png

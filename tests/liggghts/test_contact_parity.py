@@ -698,7 +698,45 @@ def pair_cases() -> dict[str, Case]:
             + dump_and_run(20, runs),
             check=bounce_check,
         )
+    # The same drop with neighbour builds forced at chosen steps. LIGGGHTS keeps the history of
+    # a pair across a build only if the pair touches at the positions of the build (those of
+    # the force evaluation that follows it), whatever it did at the previous evaluation: the
+    # first contact is still closed at step 1452 and open at the build of step 1453, which
+    # drops its spring (the second contact starts from zero); the second contact opens at step
+    # 3053, and the build of step 3443 (the set-up of the second run at 2800, then every 643)
+    # comes at the first step of the third contact, which resumes the spring of the second.
+    cases["pair_bounce_build_at_open_and_close"] = Case(
+        deck_header().replace("neigh_modify delay 0", "neigh_modify every 1453 delay 0 check no")
+        + f"pair_style gran {model()}\npair_coeff * *\ntimestep {DT!r}\n"
+        + particle(
+            1,
+            1,
+            tuple(c * (2 * RADIUS + 0.05 * MM) for c in drop_dir),
+            omegax=40.0,
+            omegay=-20.0,
+        )
+        + particle(2, 2, (0.0, 0.0, 0.0))
+        + gravity(100.0, (0.0, 0.0, -1.0))
+        + "group frozen id 2\nfix hold frozen freeze\n"
+        + dump_and_run(1, ["run 2800", "neigh_modify every 643 delay 0 check no", "run 1200"]),
+        check=builds_at_open_and_close_check,
+    )
     return cases
+
+
+def builds_at_open_and_close_check(snapshots):
+    """The contacts of pair_bounce_build_at_open_and_close open and close at its builds."""
+    runs: list[list[int]] = []
+    for step, rows in snapshots:
+        if all(rows[1][c] == 0.0 for c in ("tqx", "tqy", "tqz")):
+            continue
+        if runs and step <= runs[-1][1] + 1:
+            runs[-1][1] = step
+        else:
+            runs.append([step, step])
+    assert len(runs) == 3, f"three contacts expected, got {runs}"
+    assert runs[0][1] + 1 == 1453, "the first contact does not open at the build of step 1453"
+    assert runs[1][1] + 1 < 3443 == runs[2][0], "the third contact does not close at the build"
 
 
 CASES = {**pair_cases(), **wall_cases()}

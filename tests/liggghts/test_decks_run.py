@@ -16,6 +16,7 @@ cores are).
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from pathlib import Path
@@ -33,6 +34,7 @@ from demcal.core.config import load_config
 from demcal.engine_io.fix_output import read_print_file
 from demcal.engine_io.vtk_file import read_vtk_particles
 from demcal.virtual_tests.deck import DECK_NAMES, render_case
+from demcal.virtual_tests.shear_cell.plane_stress import plane_stress_series
 
 from .conftest import LiggghtsRun, run_liggghts, unexpected_warnings
 
@@ -72,7 +74,7 @@ SHEAR_CASES: dict[str, tuple[dict[str, Any], dict[str, dict[str, Any]]]] = {
     ),
     "no_rolling_friction": (
         {**BASE, "normal_stress": STRESS, "P": 0.8},
-        {"material": {"rolling_friction": False}},
+        {"material": {"rolling_friction": False}, "shear_cell": {"contact_snapshots": 25}},
     ),
 }
 
@@ -122,8 +124,33 @@ def test_shear_cell_deck_runs(name: str, tmp_path: Path) -> None:
     run = run_liggghts(tmp_path, DECK_NAMES["shear_cell"])
     check_clean_run(run)
     expected_p = [case["P"]] if "P" in case else list(cfg["shear_cell"]["P"])
-    check_shear_values(extract("shear_cell", tmp_path), expected_p)
+    table = extract("shear_cell", tmp_path)
+    check_shear_values(table, expected_p)
     check_shear_snapshot(tmp_path)
+    if cfg["shear_cell"]["contact_snapshots"]:
+        check_shear_plane(tmp_path, table.iloc[0])
+
+
+def check_shear_plane(case_dir: Path, values: pd.Series) -> None:
+    """The wall-force readout and the contacts crossing the shear plane give the same mu."""
+    record = json.loads((case_dir / "case.json").read_text())
+    readout = record["readout"]
+    table = read_print_file(case_dir / "shear_cell.txt")
+    plane = plane_stress_series(
+        case_dir / "contacts.dump", table, readout["z_shear"], readout["radius"], margin=0.0
+    )
+    for phase, key in ((1, "psh"), (3, "sh")):
+        window = plane[
+            (plane["phase"] == phase)
+            & (plane["time"] >= values[f"{key}_t_start"])
+            & (plane["time"] <= values[f"{key}_t_end"])
+        ]
+        assert len(window) >= 3, (phase, plane)
+        # Snapshots sample the same plateau as the print rows, more sparsely.
+        assert window["mu"].mean() == pytest.approx(values[f"mu_{key}"], rel=0.1), (
+            phase,
+            window["mu"].tolist(),
+        )
 
 
 def test_shear_cell_deck_runs_on_two_mpi_ranks(tmp_path: Path) -> None:

@@ -122,6 +122,7 @@ def test_shear_deck_numbers_match_the_setup(tmp_path: Path) -> None:
     assert deck.count("variable phase equal 1\n") == 4
     assert deck.count("variable phase equal 3\n") == 4
     assert deck.count("fix shear all move/mesh mesh lower linear") == 4 * 2 + 3
+    assert deck.count("fix shearfl all move/mesh mesh lflange linear") == 4 * 2 + 3
     assert s["preshear_force"] == pytest.approx(2029.0 * math.pi * s["radius"] ** 2)
 
 
@@ -189,10 +190,19 @@ def test_meshes_have_the_cell_geometry(tmp_path: Path) -> None:
     assert surface_area(lid) == pytest.approx(polygon, rel=1e-9)
     lower = read_stl(tmp_path / "meshes" / "shear_lower.stl").triangles
     assert lower[..., 2].max() == pytest.approx(s["z_shear"])
-    assert lower[..., 0].max() == pytest.approx(s["radius"] + s["flange_width"])
+    assert np.hypot(lower[..., 0], lower[..., 1]).max() == pytest.approx(s["radius"])
     upper = read_stl(tmp_path / "meshes" / "shear_upper.stl").triangles
     assert upper[..., 2].min() == pytest.approx(s["z_shear"])
     assert upper[..., 2].max() == pytest.approx(s["wall_top"])
+    assert np.hypot(upper[..., 0], upper[..., 1]).max() == pytest.approx(s["radius"])
+    # The flanges are meshes of their own, flat at the shear plane, from R to R + flange width.
+    for name in ("shear_lower_flange.stl", "shear_upper_flange.stl"):
+        flange = read_stl(tmp_path / "meshes" / name).triangles
+        assert np.ptp(flange[..., 2]) == 0.0
+        assert flange[..., 2].max() == pytest.approx(s["z_shear"])
+        reach = np.hypot(flange[..., 0], flange[..., 1])
+        assert reach.min() == pytest.approx(s["radius"])
+        assert reach.max() == pytest.approx(s["radius"] + s["flange_width"])
 
 
 def test_case_json_holds_the_readout_inputs(tmp_path: Path) -> None:
@@ -318,7 +328,10 @@ def write_shear_table(directory: Path, mu_psh: float, mu_sh: float, rho_b: float
     s = record["setup"]
     area = math.pi * s["radius"] ** 2
     lid_z = 1.4 * s["fill_height"]
-    rows = ["# step time phase cycle lid_z lid_force shear_force travel mass target_force"]
+    rows = [
+        "# step time phase cycle lid_z lid_force shear_force travel mass target_force "
+        "upper_force_z lower_flange_force_z"
+    ]
     for seg in s["segments"]:
         start = seg["start_step"] - seg["start_step"] % s["print_every"] + s["print_every"]
         for step in range(start, seg["start_step"] + seg["steps"] + 1, s["print_every"]):
@@ -326,9 +339,12 @@ def write_shear_table(directory: Path, mu_psh: float, mu_sh: float, rho_b: float
             lid = seg["target_force"]
             weight = rho_b * 9.81 * area * (lid_z - s["z_shear"])
             mu = {1: mu_psh, 3: mu_sh}.get(seg["phase"], 0.0)
+            upper_z, flange_z = 0.3 * lid, -0.02 * lid
+            shear = mu * (lid + weight + upper_z + flange_z)
             rows.append(
                 f"{step} {step * s['timestep']!r} {seg['phase']} {seg['cycle']} {lid_z!r} "
-                f"{lid!r} {mu * (lid + weight)!r} {travel!r} {rho_b * area * lid_z!r} {lid!r}"
+                f"{lid!r} {shear!r} {travel!r} {rho_b * area * lid_z!r} {lid!r} "
+                f"{upper_z!r} {flange_z!r}"
             )
     (directory / "shear_cell.txt").write_text("\n".join(rows) + "\n")
 

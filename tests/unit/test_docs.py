@@ -307,6 +307,7 @@ def test_pages_exist():
         "quickstart.md",
         "configuration.md",
         "virtual-tests.md",
+        "convergence.md",
         "identification.md",
         "discrepancy.md",
         "cluster.md",

@@ -85,8 +85,9 @@ def synthetic_run(
 
     Each cycle dict holds normal_stress (Pa), P, mu_psh, mu_sh and rho_b (kg/m^3). The mass in
     the cell is fixed; a cycle's rho_b sets its lid height. The shear force is built as mu(t)
-    times (lid force + weight above the shear plane), so the readout must return mu(t) up to
-    the added noise.
+    times the normal force across the shear plane (lid force + weight above the plane + the
+    upper tube's and the lower flange's vertical forces), so the readout must return mu(t) up
+    to the added noise.
     """
     rng = np.random.default_rng(seed)
     mass = 1760.0 * AREA * 0.03
@@ -104,6 +105,8 @@ def synthetic_run(
                 "shear_force": 0.0,
                 "travel": 0.0,
                 "target_force": target0,
+                "upper_force_z": 0.0,
+                "lower_flange_force_z": 0.0,
             }
         )
     )
@@ -122,6 +125,10 @@ def synthetic_run(
             lid_z = lid_height + 2e-6 * rng.standard_normal(n)
             lid_force = load * (1.0 + 0.02 * rng.standard_normal(n))
             weight = mass * G * (lid_z - Z_SHEAR) / (lid_z - Z_FLOOR)
+            # A dilating bed held down by the upper tube's friction, a small load on the
+            # uncovered flange: the normal force across the plane is not the lid force.
+            upper_z = 0.4 * lid_force * (phase != 2)
+            flange_z = -0.03 * lid_force * (phase != 2)
             if phase == 2:
                 mu = np.zeros(n)
                 travel = np.full(n, -V_WALL * (times[0] - t_start))
@@ -137,9 +144,11 @@ def synthetic_run(
                         "cycle": c,
                         "lid_z": lid_z,
                         "lid_force": lid_force,
-                        "shear_force": -mu * (lid_force + weight),
+                        "shear_force": -mu * (lid_force + weight + upper_z + flange_z),
                         "travel": travel,
                         "target_force": load,
+                        "upper_force_z": upper_z,
+                        "lower_flange_force_z": flange_z,
                     }
                 )
             )
@@ -161,6 +170,7 @@ CYCLES = [
 def test_stress_series_by_hand() -> None:
     # One row with round numbers: rho_b = 1500 kg/m^3 by construction.
     lid_z, travel, lid_force, shear = 0.03, 0.004, 10.0, -6.0
+    upper_z, flange_z = 2.5, -0.5
     row = pd.DataFrame(
         {
             "time": [1.0],
@@ -172,6 +182,8 @@ def test_stress_series_by_hand() -> None:
             "travel": [travel],
             "mass": [1500.0 * AREA * lid_z],
             "target_force": [10.0],
+            "upper_force_z": [upper_z],
+            "lower_flange_force_z": [flange_z],
         }
     )
     out = shear_stress_series(row, R, Z_FLOOR, Z_SHEAR, G).iloc[0]
@@ -179,9 +191,11 @@ def test_stress_series_by_hand() -> None:
     weight = 1500.0 * G * AREA * (lid_z - Z_SHEAR)
     assert out["rho_b"] == pytest.approx(1500.0, rel=1e-12)
     assert out["area"] == pytest.approx(area, rel=1e-12)
-    assert out["sigma"] == pytest.approx((lid_force + weight) / area, rel=1e-12)
+    normal = lid_force + weight + upper_z + flange_z
+    assert out["sigma"] == pytest.approx(normal / area, rel=1e-12)
     assert out["tau"] == pytest.approx(6.0 / area, rel=1e-12)
-    assert out["mu"] == pytest.approx(6.0 / (lid_force + weight), rel=1e-12)
+    assert out["mu"] == pytest.approx(6.0 / normal, rel=1e-12)
+
 
 
 def test_bulk_values_recovered_per_cycle() -> None:
@@ -203,14 +217,26 @@ def test_bulk_values_recovered_per_cycle() -> None:
 
 
 def test_weight_of_the_column_enters_sigma() -> None:
-    # Ignoring gravity in the readout raises mu by (lid force + weight) / lid force.
+    # Ignoring gravity in the readout raises mu by N / (N - weight), N the normal force across
+    # the plane (lid force 1 + 0.4 - 0.03 of it from the walls, see synthetic_run, + weight).
     table = synthetic_run(CYCLES[:1], seed=2)
     with_g = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
     without_g = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, g=0.0)
     weight = 1760.0 * G * AREA * (0.03 - Z_SHEAR)
-    lid = 2029.0 * AREA
+    walls = 1.37 * 2029.0 * AREA
     ratio = without_g["mu_psh"].iloc[0] / with_g["mu_psh"].iloc[0]
-    assert ratio == pytest.approx((lid + weight) / lid, rel=2e-3)
+    assert ratio == pytest.approx((walls + weight) / walls, rel=2e-3)
+
+
+def test_upper_tube_force_enters_sigma() -> None:
+    # A readout from lid force and weight alone overstates mu by N / (lid + weight) when the
+    # upper tube holds a dilating bed down.
+    table = synthetic_run(CYCLES[:1], seed=2)
+    got = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
+    assert got["mu_psh"].iloc[0] == pytest.approx(CYCLES[0]["mu_psh"], abs=0.01)
+    no_walls = table.assign(upper_force_z=0.0, lower_flange_force_z=0.0)
+    naive = shear_cell_bulk_values(no_walls, R, Z_FLOOR, Z_SHEAR, G)
+    assert naive["mu_psh"].iloc[0] > 1.3 * CYCLES[0]["mu_psh"]
 
 
 def test_interrupted_run_flags_unsteady_and_missing_phases() -> None:

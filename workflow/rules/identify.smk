@@ -14,6 +14,8 @@ rule identify:
     input:
         models=expand(f"{RESULTS}/surrogates/{{output}}/model.pt", output=OUTPUTS_TRAINED),
         experiment=config["experiment"],
+        # for the first line of Table 5: can the model reach the measurement at all?
+        dataset=DATASET,
     output:
         table5=report(
             f"{RESULTS}/identification/table5.md",
@@ -98,3 +100,37 @@ rule verification_table:
         CONDA_ENV
     script:
         "../../scripts/verification_table.py"
+
+
+# The first verification engine's first case of each test, drawn: the settled heap, the shear
+# cell at the end of the pre-shear, and mu(t) with the windows the readout averaged.
+VERIFICATION_PICTURES = {
+    "heap": "heap.png",
+    "shear_cell": "shear_cell.png",
+    "mu_series": "mu_series.png",
+}
+
+
+rule verification_pictures:
+    input:
+        **{
+            test: f"{RESULTS}/verification/{next(iter(VERIFICATION_ENGINES))}/{test}/"
+            f"{VERIFICATION_CASES[test][0]}/bulk.csv"
+            for test in TESTS
+        },
+    output:
+        **{
+            key: report(
+                f"{RESULTS}/verification/pictures/{name}",
+                category="Identification",
+                caption="../report/verification_pictures.rst",
+            )
+            for key, name in VERIFICATION_PICTURES.items()
+        },
+    log:
+        f"{LOGS}/verification/verification_pictures.log",
+    localrule: True
+    conda:
+        CONDA_ENV
+    script:
+        "../../scripts/verification_pictures.py"

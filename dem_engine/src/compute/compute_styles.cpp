@@ -31,12 +31,13 @@ std::unique_ptr<Compute> make_compute(Simulation& sim, const Command& command) {
       {"erotate/sphere", make_erotate_sphere},
       {"contact/atom", make_contact_atom},
       {"reduce", make_reduce},
+      {"pair/gran/local", make_pair_gran_local},
   };
   const std::string style = command.args.size() > 2 ? command.args[2] : std::string();
   const auto it = styles.find(style);
   if (it == styles.end())
     throw EngineError("unknown compute style '" + style +
-                      "' (supported: erotate/sphere, contact/atom, reduce)");
+                      "' (supported: erotate/sphere, contact/atom, reduce, pair/gran/local)");
   return it->second(sim, command);
 }
 

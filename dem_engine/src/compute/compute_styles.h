@@ -9,5 +9,6 @@ namespace dem {
 std::unique_ptr<Compute> make_erotate_sphere(Simulation& sim, const Command& command);
 std::unique_ptr<Compute> make_contact_atom(Simulation& sim, const Command& command);
 std::unique_ptr<Compute> make_reduce(Simulation& sim, const Command& command);
+std::unique_ptr<Compute> make_pair_gran_local(Simulation& sim, const Command& command);
 
 }  // namespace dem

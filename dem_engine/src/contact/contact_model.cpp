@@ -163,8 +163,8 @@ class ComposedModel final : public ContactModel {
         // Pass 1 sorts the listed pairs into touching ones, without branching on a
         // coin-flip condition, and flags contacts that opened. As in LIGGGHTS, the history of
         // a pair that opened is kept while the pair stays in the list (a contact that closes
-        // again before the next neighbour build resumes it); the build drops it (see
-        // NeighborList::build).
+        // again before the next neighbour build resumes it); the build drops it unless the
+        // pair touches at the build's positions (see NeighborList::build).
         int m = 0;
         for (int k = first[i]; k < k_end; ++k) {
           const int j = partner[k];

@@ -11,8 +11,8 @@ namespace dem {
 
 // Half neighbour list (each pair once, i < j) from cell binning with a skin. Contact history
 // lives beside the list and survives rebuilds, matched by particle tags, for the pairs that
-// touched at their last evaluation; the history of a pair that opened is kept until the next
-// build and dropped there (LIGGGHTS semantics).
+// touch at the positions of the build; the history of a pair that opened is kept while the pair
+// stays in the list and dropped by a build at which it does not touch (LIGGGHTS semantics).
 // Order of the particles along a cell grid (cells of size `cell`, x fastest), so that
 // neighbours in space are neighbours in memory.
 std::vector<std::size_t> spatial_order(const Particles& p, double cell);
@@ -27,8 +27,9 @@ class NeighborList {
   std::vector<int> first;         // size n+1: pairs of i are [first[i], first[i+1])
   std::vector<int> partner;       // j for every pair
   std::vector<double> history;    // kHistorySize doubles per pair
-  // Per pair: 1 when the pair touched at its last evaluation (set at a build for the pairs
-  // whose history was carried over). Only such histories are carried over by a build.
+  // Per pair: 1 when the pair touched at its last evaluation (set by the pair loop, and at a
+  // build for the pairs that touch at its positions). A build does not read it: it keeps the
+  // histories of the pairs that touch at its own positions (see mark_touching).
   std::vector<std::uint8_t> touching;
 
   // True when every rebuild check is done at every step, so that no particle moves more than
@@ -51,8 +52,9 @@ class NeighborList {
   int max_pairs_per_particle() const { return max_pairs_; }
 
  private:
-  // Sets `touching` from the history and balances the partition by contacts.
-  void mark_touching(int nthreads);
+  // Sets `touching` from the positions of the build, drops the histories of the pairs apart
+  // and balances the partition by contacts.
+  void mark_touching(const Particles& p, const Domain& domain, int nthreads);
 
   std::vector<Vec3> x_at_build_;
   std::vector<std::int64_t> tags_at_build_;

@@ -5,6 +5,7 @@
 #include "deck/errors.h"
 #include "io/dump.h"
 #include "output/atom_dump.h"
+#include "output/local_dump.h"
 
 namespace dem {
 
@@ -39,6 +40,9 @@ void register_dump_styles(DumpRegistry& registry) {
   };
   registry["custom/vtk"] = [](Simulation& sim, const Command& c) {
     return std::make_unique<DumpCustomVtk>(sim, c);
+  };
+  registry["local"] = [](Simulation& sim, const Command& c) {
+    return std::make_unique<DumpLocal>(sim, c);
   };
 }
 

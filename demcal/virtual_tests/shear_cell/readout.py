@@ -3,26 +3,41 @@
 Input is the table of the deck's ``fix print`` file (read by
 :func:`demcal.engine_io.fix_output.read_print_file`), one row per print step, with the columns
 
-=============  ==========================================================================
-time           s
-phase          0 settle, 1 pre-shear, 2 unload, 3 shear
-cycle          0, 1, 2, ... one per pre-shear/shear cycle
-lid_z          m, lid height
-lid_force      N, normal force of the particles on the lid (positive)
-shear_force    N, horizontal force on the moving bottom part along the shear direction
-travel         m, displacement of the moving part since the start of the cycle
-mass           kg, particle mass in the cell
-target_force   N, the servo's target lid force in that phase
-=============  ==========================================================================
+====================  ======================================================================
+time                  s
+phase                 0 settle, 1 pre-shear, 2 unload, 3 shear
+cycle                 0, 1, 2, ... one per pre-shear/shear cycle
+lid_z                 m, lid height
+lid_force             N, normal force of the particles on the lid (positive)
+shear_force           N, horizontal force along the shear direction on the moving lower part
+                      (floor and tube) plus that on the fixed upper flange: the force the bulk
+                      carries across the shear plane (see below)
+travel                m, displacement of the moving part since the start of the cycle
+mass                  kg, particle mass in the cell
+target_force          N, the servo's target lid force in that phase
+upper_force_z         N, vertical force of the particles on the fixed upper tube (positive up)
+lower_flange_force_z  N, vertical force of the particles on the moving lower flange (positive
+                      up)
+====================  ======================================================================
 
 The split-cylinder cell of radius ``R`` has its floor at ``z_floor`` and its shear plane at
 ``z_shear``. With ``A(s)`` the overlap area of the two cylinder sections shifted by the travel
-``s``:
+``s``, the bulk above the shear plane is in equilibrium under the lid force, its weight, the
+upper tube and the lower flange (on the crescent that the moving part uncovers) and the bulk
+below, so the normal force the bulk carries across the overlap area is
+
+``N = lid_force + rho_b g pi R^2 (lid_z - z_shear) + upper_force_z + lower_flange_force_z``.
+
+The upper-tube term is the wall friction: while the sheared bed dilates the tube holds it down
+(positive), while it compacts the tube carries part of the load (negative). Ignoring it, as a
+readout from lid force and weight alone does, overstates mu by the ratio of the two normal
+forces (a factor near 2 in a narrow cell of tall fill). Likewise the moving flange's friction on
+the bulk above it is not shear across the plane, which is why ``shear_force`` adds the upper
+flange (friction of the fixed flange on the bulk below it) to the lower part but not the lower
+flange. Then
 
 * ``rho_b = mass / (pi R^2 (lid_z - z_floor))``,
-* ``sigma = (lid_force + rho_b g pi R^2 (lid_z - z_shear)) / A``: lid force plus the weight of
-  the bulk between the shear plane and the lid,
-* ``tau = |shear_force| / A`` and ``mu = tau / sigma``.
+* ``sigma = N / A`` and ``tau = |shear_force| / A``, ``mu = tau / sigma``.
 
 ``mu_psh`` and ``mu_sh`` are the means of ``mu`` over the steady plateaus detected (by
 :func:`demcal.core.steady_state.detect_plateau`) in the pre-shear and the shear phase of a
@@ -68,6 +83,8 @@ REQUIRED_COLUMNS: tuple[str, ...] = (
     "travel",
     "mass",
     "target_force",
+    "upper_force_z",
+    "lower_flange_force_z",
 )
 
 _SOURCE = "shear-cell table"
@@ -179,15 +196,22 @@ def shear_stress_series(
     """
     _validated(table, radius, z_floor, z_shear)
     out = table.copy()
+    column = {name: out[name].to_numpy(dtype=np.float64) for name in REQUIRED_COLUMNS}
     cross_section = np.pi * radius**2
-    lid_z = out["lid_z"].to_numpy(dtype=np.float64)
-    area = np.asarray(overlap_area(radius, out["travel"].to_numpy(dtype=np.float64)))
+    lid_z = column["lid_z"]
+    area = np.asarray(overlap_area(radius, column["travel"]))
     with np.errstate(divide="ignore", invalid="ignore"):
         # Settling and unloading rows may have a lid near the floor; only phases 1 and 3 count.
-        rho_b = out["mass"].to_numpy(dtype=np.float64) / (cross_section * (lid_z - z_floor))
+        rho_b = column["mass"] / (cross_section * (lid_z - z_floor))
         weight_above = rho_b * g * cross_section * (lid_z - z_shear)
-        sigma = (out["lid_force"].to_numpy(dtype=np.float64) + weight_above) / area
-        tau = np.abs(out["shear_force"].to_numpy(dtype=np.float64)) / area
+        normal = (
+            column["lid_force"]
+            + weight_above
+            + column["upper_force_z"]
+            + column["lower_flange_force_z"]
+        )
+        sigma = normal / area
+        tau = np.abs(column["shear_force"]) / area
         mu = tau / sigma
     out["area"] = area
     out["rho_b"] = rho_b

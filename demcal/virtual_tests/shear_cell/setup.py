@@ -159,6 +159,9 @@ class ShearCellSetup(RunSetup):
     inertial_number_min_stress : float
         Inertial number of the shear band (10 particle diameters wide) at the smallest shear
         normal stress, -.
+    contact_dump_every : int
+        Steps between contact snapshots (``shear_cell.contact_snapshots`` per pre-shear), 0 for
+        none.
     """
 
     radius: float
@@ -193,6 +196,7 @@ class ShearCellSetup(RunSetup):
     shear_time: float
     unload_time: float
     inertial_number_min_stress: float
+    contact_dump_every: int = 0
 
     @property
     def cross_section(self) -> float:
@@ -368,6 +372,11 @@ def shear_cell_setup(
         raise SetupError(
             f"configuration: 'shear_cell.samples_per_preshear' must be >= 20, got {samples}"
         )
+    snapshots = int(_get(cell, "contact_snapshots", where))
+    if snapshots < 0:
+        raise SetupError(
+            f"configuration: 'shear_cell.contact_snapshots' must be >= 0, got {snapshots}"
+        )
     smallest_stress = normal_stress * min(p_values)
     return ShearCellSetup(
         radius=radius,
@@ -409,5 +418,6 @@ def shear_cell_setup(
         shear_time=t_sh,
         unload_time=t_unload,
         inertial_number_min_stress=inertial_number(speed, 10.0, smallest_stress, material.density),
+        contact_dump_every=max(1, n_psh // snapshots) if snapshots else 0,
         seeds=insertion_seeds(seed, dist.n_classes),
     )

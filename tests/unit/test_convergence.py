@@ -1,0 +1,113 @@
+"""Planning and condensing the convergence study of the virtual tests (no DEM runs here)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from demcal.bulk.convergence import FACTORS, Factor, plan_study, summarise
+from demcal.core.config import load_config
+
+ROOT = Path(__file__).resolve().parents[2]
+SET = {
+    "coefficientFriction": 0.5,
+    "coefficientRollingFriction": 0.2,
+    "coefficientRestitution": 0.6,
+    "density": 2500.0,
+}
+
+
+def test_levels_are_applied_and_the_base_run_is_shared(tmp_path: Path) -> None:
+    settings = load_config(ROOT / "config" / "tiny.yaml")
+    base_size = settings["shear_cell"]["dCylDp"]
+    size = Factor(
+        "size",
+        "shear_cell",
+        "dCylDp",
+        tuple({"shear_cell.dCylDp": d} for d in (6, base_size)),
+        "shear_cell.dCylDp",
+    )
+    speed = Factor(
+        "speed",
+        "shear_cell",
+        "v",
+        tuple(
+            {"shear_cell.shear_speed": v}
+            for v in (
+                2 * settings["shear_cell"]["shear_speed"],
+                settings["shear_cell"]["shear_speed"],
+            )
+        ),
+        "shear_cell.shear_speed",
+    )
+    planned = plan_study(
+        settings, {"a": SET}, [size, speed], [1, 2], tmp_path, "dem_engine -in {deck}", 2029.0
+    )
+    assert len(planned) == 2 * 2 * 2
+    dirs = {job.case_dir for job, _, _ in planned}
+    # The most refined level of both factors is the base configuration: one run per seed.
+    assert len(dirs) == 3 * 2
+    assert (tmp_path / "shear_cell" / "base" / "a" / "seed1" / "in.shear_cell").is_file()
+    small = json.loads(
+        (tmp_path / "shear_cell" / "shear_cell.dCylDp=6" / "a" / "seed2" / "case.json").read_text()
+    )
+    # dCylDp 6 is below the production minimum; the study renders it anyway.
+    assert small["case"]["dCylDp"] == 6.0
+    assert small["setup"]["radius"] == pytest.approx(6.0 * small["setup"]["reference_radius"])
+    assert small["case"]["normal_stress"] == 2029.0
+    # A finished run is not rendered again.
+    status = tmp_path / "shear_cell" / "base" / "a" / "seed1" / "status.json"
+    status.write_text('{"status": "ok"}')
+    deck = status.parent / "in.shear_cell"
+    deck.write_text("kept\n")
+    plan_study(settings, {"a": SET}, [size], [1], tmp_path, "dem_engine -in {deck}", 2029.0)
+    assert deck.read_text() == "kept\n"
+
+
+def test_summary_measures_distance_to_the_most_refined_level() -> None:
+    factor = FACTORS["shear_dCylDp"]
+    levels = [factor.level_value(level) for level in factor.levels]
+    rng = np.random.default_rng(3)
+    # mu_psh falls from 1.0 towards 0.6 with cell size; the two largest cells differ by 3 %.
+    truth = dict(zip(levels, (1.0, 0.8, 0.618, 0.6), strict=True))
+    rows = [
+        {
+            "factor": factor.name,
+            "level": lv,
+            "set": "mid",
+            "seed": s,
+            "quantity": "mu_psh",
+            "value": truth[lv] + 0.002 * rng.standard_normal(),
+        }
+        for lv in levels
+        for s in (1, 2, 3)
+    ]
+    rows += [
+        {
+            "factor": "aor_lift_time",
+            "level": lv,
+            "set": "mid",
+            "seed": 1,
+            "quantity": "aor",
+            "value": 30.0 + (3.0 if lv == 1.0 else 0.5),
+        }
+        for lv in (1.0, 2.0, 4.0, 8.0)
+    ]
+    summary = summarise(pd.DataFrame(rows), FACTORS).set_index(["factor", "level"])
+    mu = summary.loc["shear_dCylDp"]
+    assert mu.loc[levels[-1], "deviation"] == 0.0
+    assert mu.loc[levels[0], "deviation"] == pytest.approx(0.4 / 0.6, abs=0.02)
+    assert mu["converged"].tolist() == [False, False, True, True]
+    assert (mu["n"] == 3).all() and (mu["sd"] < 0.01).all()
+    # Seed noise of 0.002 on 0.6: every deviation but the reference's is beyond it.
+    assert (mu["deviation_se"].iloc[:-1] < 0.01).all()
+    assert mu["resolved"].tolist() == [True, True, True, False]
+    # The angle of repose is judged in degrees: 3 deg off fails, 0 deg passes.
+    aor = summary.loc["aor_lift_time"]
+    assert aor.loc[1.0, "deviation"] == pytest.approx(2.5)
+    assert aor["converged"].tolist() == [False, True, True, True]
+    assert np.isnan(aor.loc[1.0, "sd"])

@@ -1,0 +1,58 @@
+"""Is a measured value within the range of the design's DEM runs? (first line of Table 5)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+import yaml
+
+from demcal.core.experiments import load_experiment
+from demcal.identification.reachability import reach_of_measurements, reach_statement
+
+DATA = pd.DataFrame(
+    {
+        "test": ["shear_cell"] * 4 + ["angle_of_repose"] * 3,
+        "normal_stress": [1068.0, 1068.0, 10070.0, 10070.0] + [float("nan")] * 3,
+        "P": [1.0, 1.0, 1.0, 1.0] + [float("nan")] * 3,
+        "rho_b": [1400.0, 1500.0, 1650.0, 1720.0] + [float("nan")] * 3,
+        "aor": [float("nan")] * 4 + [7.8, 25.0, 33.0],
+    }
+)
+
+
+def experiment(tmp_path: Path, rho_b: float, aor: float):
+    path = tmp_path / "exp.yaml"
+    record = {
+        "material": "test fines",
+        "angle_of_repose": {"value": aor},
+        "shear_cell": [{"normal_stress": 10070, "P": 1.0, "rho_b": rho_b}],
+    }
+    path.write_text(yaml.safe_dump(record))
+    return load_experiment(path)
+
+
+def test_a_measurement_inside_the_widened_range_is_reachable(tmp_path: Path) -> None:
+    # 1760 lies 2.3 % above the largest DEM value at 10 070 Pa, within the 5 % tolerance.
+    reach = reach_of_measurements(DATA, experiment(tmp_path, 1760.0, 30.0), tol=0.05)
+    assert [r.reachable for r in reach] == [True, True]
+    assert (reach[0].dem_min, reach[0].dem_max, reach[0].n_runs) == (1650.0, 1720.0, 2)
+    assert reach_statement(reach, "test fines").startswith("Every measured value")
+
+
+def test_the_first_line_names_what_cannot_be_reached(tmp_path: Path) -> None:
+    # The sinter fines' 38.85 deg against quick heaps of 7.8-33 deg; rho_b below the range.
+    reach = reach_of_measurements(DATA, experiment(tmp_path, 1500.0, 38.85), tol=0.05)
+    assert [r.reachable for r in reach] == [False, False]
+    line = reach_statement(reach, "test fines")
+    assert line.startswith("**The model cannot reach the measurement of test fines**")
+    assert "aor (angle of repose) measured 38.85, DEM runs of the design box 7.8 to 33" in line
+    assert "rho_b" in line and "1650 to 1720" in line
+    assert "\n" not in line
+
+
+def test_a_condition_without_runs_is_not_reachable(tmp_path: Path) -> None:
+    no_aor = DATA[DATA["test"] == "shear_cell"]
+    reach = reach_of_measurements(no_aor, experiment(tmp_path, 1700.0, 30.0), tol=0.05)
+    assert reach[1].n_runs == 0 and not reach[1].reachable
+    assert "no DEM run of the design has a value" in reach_statement(reach, "x")
