@@ -5,7 +5,6 @@ from __future__ import annotations
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -15,6 +14,12 @@ from demcal.engine_io.output_errors import (
     EngineOutputError,
     TruncatedOutputWarning,
     require_columns,
+)
+from demcal.engine_io.snapshot_text import (
+    IncompleteSnapshot,
+    SnapshotLines,
+    read_snapshots,
+    snapshot_starts,
 )
 from demcal.engine_io.text_table import check_unique, numeric_frame, parse_row, read_lines
 
@@ -46,14 +51,6 @@ class DumpSnapshot:
     tilt: np.ndarray | None = field(default=None)
 
 
-class _IncompleteSnapshot(Exception):
-    """The snapshot runs into the end of the file."""
-
-
-def _dump_starts(lines: list[str]) -> list[int]:
-    return [i for i, ln in enumerate(lines) if ln.startswith("ITEM: TIMESTEP")]
-
-
 def _parse_dump_snapshot(
     lines: list[str],
     start: int,
@@ -64,23 +61,8 @@ def _parse_dump_snapshot(
 ) -> DumpSnapshot:
     """Parse ``lines[start:stop]``, one snapshot beginning with ``ITEM: TIMESTEP``."""
 
-    def need(i: int) -> str:
-        if i >= stop:
-            if at_end:
-                raise _IncompleteSnapshot
-            raise EngineOutputError(path, "snapshot ends early", i + 1)
-        return lines[i]
-
-    def integer(i: int) -> int:
-        text = need(i).strip()
-        try:
-            return int(text)
-        except ValueError:
-            if at_end and i == stop - 1:
-                raise _IncompleteSnapshot from None
-            raise EngineOutputError(
-                path, f"expected an integer, got {text[:40]!r}", i + 1
-            ) from None
+    cursor = SnapshotLines(lines, stop, path, at_end)
+    need, integer = cursor.need, cursor.integer
 
     i = start + 1
     timestep = integer(i)
@@ -122,7 +104,7 @@ def _parse_dump_snapshot(
     first_row = i + 1
     if stop - first_row < n_atoms:
         if at_end:
-            raise _IncompleteSnapshot
+            raise IncompleteSnapshot
         raise EngineOutputError(
             path, f"expected {n_atoms} atom rows, found {stop - first_row}", first_row
         )
@@ -131,7 +113,7 @@ def _parse_dump_snapshot(
             path, f"more than {n_atoms} atom rows in snapshot", first_row + n_atoms + 1
         )
     if at_end and n_atoms > 0 and not ends_nl and first_row + n_atoms == len(lines):
-        raise _IncompleteSnapshot
+        raise IncompleteSnapshot
     block = [ln.split() for ln in lines[first_row : first_row + n_atoms]]
     data = np.empty((0, len(names)))
     well_formed = n_atoms == 0
@@ -145,7 +127,7 @@ def _parse_dump_snapshot(
         for k, toks in enumerate(block):
             if len(toks) != len(names) or parse_row(toks) is None:
                 if at_end and k == n_atoms - 1:
-                    raise _IncompleteSnapshot
+                    raise IncompleteSnapshot
                 raise EngineOutputError(
                     path, f"expected {len(names)} numeric fields in atom row", first_row + k + 1
                 )
@@ -179,27 +161,9 @@ def read_dump(
         A column in ``columns`` is absent from a snapshot.
     """
     lines, ends_nl = read_lines(path)
-    starts = _dump_starts(lines)
-    if not starts:
-        raise EngineOutputError(path, "no 'ITEM: TIMESTEP' line found")
-    snapshots = []
-    bounds = [*starts, len(lines)]
-    for k, (s, e) in enumerate(pairwise(bounds)):
-        at_end = k == len(starts) - 1
-        try:
-            snap = _parse_dump_snapshot(lines, s, e, path, at_end, ends_nl)
-        except _IncompleteSnapshot:
-            warnings.warn(
-                f"{path}:{s + 1}: dropped incomplete last snapshot",
-                TruncatedOutputWarning,
-                stacklevel=2,
-            )
-            break
-        require_columns(list(snap.atoms.columns), columns, f"{path}:{s + 1}")
-        snapshots.append(snap)
-    if not snapshots:
-        raise EngineOutputError(path, "no complete snapshot")
-    return snapshots
+    return read_snapshots(
+        lines, ends_nl, path, _parse_dump_snapshot, lambda snap: snap.atoms.columns, columns
+    )
 
 
 def read_dump_last(
@@ -228,7 +192,7 @@ def read_dump_last(
         A column in ``columns`` is absent.
     """
     lines, ends_nl = read_lines(path)
-    starts = _dump_starts(lines)
+    starts = snapshot_starts(lines)
     if not starts:
         raise EngineOutputError(path, "no 'ITEM: TIMESTEP' line found")
     bounds = [*starts, len(lines)]
@@ -237,7 +201,7 @@ def read_dump_last(
             snap = _parse_dump_snapshot(
                 lines, bounds[k], bounds[k + 1], path, k == len(starts) - 1, ends_nl
             )
-        except _IncompleteSnapshot:
+        except IncompleteSnapshot:
             warnings.warn(
                 f"{path}:{bounds[k] + 1}: dropped incomplete last snapshot",
                 TruncatedOutputWarning,

@@ -21,9 +21,7 @@ columns of ``pair/gran/local`` in the order LIGGGHTS 3.8 writes them.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
-from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -31,8 +29,12 @@ import pandas as pd
 
 from demcal.engine_io.output_errors import (
     EngineOutputError,
-    TruncatedOutputWarning,
-    require_columns,
+)
+from demcal.engine_io.snapshot_text import (
+    IncompleteSnapshot,
+    SnapshotLines,
+    read_snapshots,
+    snapshot_starts,
 )
 from demcal.engine_io.text_table import check_unique, numeric_frame, parse_row, read_lines
 
@@ -96,32 +98,13 @@ def pair_gran_local_columns(keywords: Sequence[str] = (), history_size: int = 3)
     return names
 
 
-class _IncompleteSnapshot(Exception):
-    """The snapshot runs into the end of the file."""
-
-
 def _parse_snapshot(
     lines: list[str], start: int, stop: int, path: str | Path, at_end: bool, ends_nl: bool
 ) -> tuple[int, pd.DataFrame]:
     """Parse ``lines[start:stop]``, one snapshot beginning with ``ITEM: TIMESTEP``."""
 
-    def need(i: int) -> str:
-        if i >= stop:
-            if at_end:
-                raise _IncompleteSnapshot
-            raise EngineOutputError(path, "snapshot ends early", i + 1)
-        return lines[i]
-
-    def integer(i: int) -> int:
-        text = need(i).strip()
-        try:
-            return int(text)
-        except ValueError:
-            if at_end and i == stop - 1:
-                raise _IncompleteSnapshot from None
-            raise EngineOutputError(
-                path, f"expected an integer, got {text[:40]!r}", i + 1
-            ) from None
+    cursor = SnapshotLines(lines, stop, path, at_end)
+    need, integer = cursor.need, cursor.integer
 
     timestep = integer(start + 1)
     i = start + 2
@@ -153,7 +136,7 @@ def _parse_snapshot(
     available = stop - first_row
     if available < n_entries:
         if at_end:
-            raise _IncompleteSnapshot
+            raise IncompleteSnapshot
         raise EngineOutputError(  # at the line where the next row is missing
             path, f"expected {n_entries} entry rows, found {available}", stop + 1
         )
@@ -162,14 +145,14 @@ def _parse_snapshot(
             path, f"more than {n_entries} entry rows in snapshot", first_row + n_entries + 1
         )
     if at_end and n_entries > 0 and not ends_nl and first_row + n_entries == len(lines):
-        raise _IncompleteSnapshot  # the last row may be cut
+        raise IncompleteSnapshot  # the last row may be cut
     data = np.empty((n_entries, len(names)))
     for k, line in enumerate(lines[first_row : first_row + n_entries]):
         toks = line.split()
         values = parse_row(toks) if len(toks) == len(names) else None
         if values is None:
             if at_end and k == n_entries - 1:
-                raise _IncompleteSnapshot
+                raise IncompleteSnapshot
             raise EngineOutputError(
                 path, f"expected {len(names)} numeric fields in entry row", first_row + k + 1
             )
@@ -209,25 +192,9 @@ def read_local_dump(
         A column in ``columns`` is absent from a snapshot.
     """
     lines, ends_nl = read_lines(path)
-    starts = [i for i, ln in enumerate(lines) if ln.startswith("ITEM: TIMESTEP")]
-    if not starts:
-        raise EngineOutputError(path, "no 'ITEM: TIMESTEP' line found")
-    if any(ln.strip() for ln in lines[: starts[0]]):
+    starts = snapshot_starts(lines)
+    if starts and any(ln.strip() for ln in lines[: starts[0]]):
         raise EngineOutputError(path, "text before the first 'ITEM: TIMESTEP'", 1)
-    snapshots: list[tuple[int, pd.DataFrame]] = []
-    for k, (s, e) in enumerate(pairwise([*starts, len(lines)])):
-        at_end = k == len(starts) - 1
-        try:
-            step, frame = _parse_snapshot(lines, s, e, path, at_end, ends_nl)
-        except _IncompleteSnapshot:
-            warnings.warn(
-                f"{path}:{s + 1}: dropped incomplete last snapshot",
-                TruncatedOutputWarning,
-                stacklevel=2,
-            )
-            break
-        require_columns(list(frame.columns), columns, f"{path}:{s + 1}")
-        snapshots.append((step, frame))
-    if not snapshots:
-        raise EngineOutputError(path, "no complete snapshot")
-    return snapshots
+    return read_snapshots(
+        lines, ends_nl, path, _parse_snapshot, lambda snap: snap[1].columns, columns
+    )

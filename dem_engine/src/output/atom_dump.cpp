@@ -46,59 +46,13 @@ void AtomDump::modify(const std::vector<std::string>& args) {
   }
 }
 
-namespace {
-
-// The printf format for an integer field: exactly one %[flags][width]d|i conversion (plus
-// literal text and %%), rewritten to take a long long.
-std::string integer_format(const std::string& token) {
-  std::string out;
-  int conversions = 0;
-  for (std::size_t i = 0; i < token.size();) {
-    if (token[i] != '%') {
-      out += token[i++];
-      continue;
-    }
-    if (i + 1 < token.size() && token[i + 1] == '%') {
-      out += "%%";
-      i += 2;
-      continue;
-    }
-    std::size_t j = i + 1;
-    while (j < token.size() && std::string("-+ 0#").find(token[j]) != std::string::npos) ++j;
-    while (j < token.size() && token[j] >= '0' && token[j] <= '9') ++j;
-    if (j >= token.size() || (token[j] != 'd' && token[j] != 'i'))
-      throw EngineError("dump_modify format '" + token +
-                        "': an integer field needs one %d conversion");
-    out += token.substr(i, j - i) + "lld";
-    i = j + 1;
-    ++conversions;
-  }
-  if (conversions != 1)
-    throw EngineError("dump_modify format '" + token +
-                      "': an integer field needs exactly one %d conversion");
-  return out;
-}
-
-}  // namespace
-
 void AtomDump::set_format(const std::string& text) {
   formats_.clear();
   if (text == "none") return;
-  std::vector<std::string> tokens;
-  std::size_t i = 0;
-  while (i < text.size()) {
-    while (i < text.size() && text[i] == ' ') ++i;
-    std::size_t j = i;
-    while (j < text.size() && text[j] != ' ') ++j;
-    if (j > i) tokens.push_back(text.substr(i, j - i));
-    i = j;
-  }
-  if (tokens.size() < fields_.size())
-    throw EngineError("dump_modify format string is too short (" + std::to_string(tokens.size()) +
-                      " formats for " + std::to_string(fields_.size()) + " fields)");
+  const std::vector<std::string> tokens = format_tokens(text, fields_.size(), "fields");
   for (std::size_t k = 0; k < fields_.size(); ++k) {
     if (fields_[k].integer()) {
-      formats_.push_back(integer_format(tokens[k]));
+      formats_.push_back(integer_format(tokens[k], "an integer field"));
     } else {
       deck_lexer::format_number(tokens[k], 0.0);  // validates: one floating-point conversion
       formats_.push_back(tokens[k]);
@@ -139,25 +93,7 @@ void AtomDump::write() {
 
 // --- dump custom ---------------------------------------------------------------------------
 
-namespace {
 
-// `format` was checked by integer_format to hold one long long conversion.
-std::string integer_text(const std::string& format, long long value) {
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wformat-nonliteral"
-#endif
-  const int length = std::snprintf(nullptr, 0, format.c_str(), value);
-  std::string out(static_cast<std::size_t>(length > 0 ? length : 0) + 1, '\0');
-  std::snprintf(out.data(), out.size(), format.c_str(), value);
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-  out.resize(static_cast<std::size_t>(length > 0 ? length : 0));
-  return out;
-}
-
-}  // namespace
 
 DumpCustom::DumpCustom(Simulation& sim, const Command& command) : AtomDump(sim, command) {
   const std::string& f = file_;

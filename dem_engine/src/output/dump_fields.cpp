@@ -1,5 +1,6 @@
 #include "output/dump_fields.h"
 
+#include <cstdio>
 #include <map>
 
 #include "deck/errors.h"
@@ -65,6 +66,68 @@ double dump_field_value(const DumpField& field, const Particles& atoms, std::siz
     case K::Compute: return compute_values.at(i);
   }
   return 0.0;
+}
+
+std::vector<std::string> format_tokens(const std::string& text, std::size_t n_columns,
+                                       const std::string& what) {
+  std::vector<std::string> tokens;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && text[i] == ' ') ++i;
+    std::size_t j = i;
+    while (j < text.size() && text[j] != ' ') ++j;
+    if (j > i) tokens.push_back(text.substr(i, j - i));
+    i = j;
+  }
+  if (tokens.size() < n_columns)
+    throw EngineError("dump_modify format string is too short (" + std::to_string(tokens.size()) +
+                      " formats for " + std::to_string(n_columns) + " " + what + ")");
+  return tokens;
+}
+
+std::string integer_format(const std::string& token, const std::string& what) {
+  std::string out;
+  int conversions = 0;
+  for (std::size_t i = 0; i < token.size();) {
+    if (token[i] != '%') {
+      out += token[i++];
+      continue;
+    }
+    if (i + 1 < token.size() && token[i + 1] == '%') {
+      out += "%%";
+      i += 2;
+      continue;
+    }
+    std::size_t j = i + 1;
+    while (j < token.size() && std::string("-+ 0#").find(token[j]) != std::string::npos) ++j;
+    while (j < token.size() && token[j] >= '0' && token[j] <= '9') ++j;
+    if (j >= token.size() || (token[j] != 'd' && token[j] != 'i'))
+      throw EngineError("dump_modify format '" + token + "': " + what +
+                        " needs one %d conversion");
+    out += token.substr(i, j - i) + "lld";
+    i = j + 1;
+    ++conversions;
+  }
+  if (conversions != 1)
+    throw EngineError("dump_modify format '" + token + "': " + what +
+                      " needs exactly one %d conversion");
+  return out;
+}
+
+std::string integer_text(const std::string& format, long long value) {
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+#endif
+  // `format` was checked by integer_format to hold one long long conversion.
+  const int length = std::snprintf(nullptr, 0, format.c_str(), value);
+  std::string out(static_cast<std::size_t>(length > 0 ? length : 0) + 1, '\0');
+  std::snprintf(out.data(), out.size(), format.c_str(), value);
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+  out.resize(static_cast<std::size_t>(length > 0 ? length : 0));
+  return out;
 }
 
 }  // namespace dem

@@ -28,4 +28,17 @@ std::vector<DumpField> parse_dump_fields(const std::vector<std::string>& words);
 double dump_field_value(const DumpField& field, const Particles& atoms, std::size_t i,
                         const std::vector<double>& compute_values);
 
+// The blank-separated formats of `dump_modify format`; throws EngineError when there are fewer
+// than `n_columns` (`what` names the columns, e.g. "fields").
+std::vector<std::string> format_tokens(const std::string& text, std::size_t n_columns,
+                                       const std::string& what);
+
+// The printf format of an integer column from a `dump_modify format` token: exactly one
+// %[flags][width]d|i conversion (plus literal text and %%), rewritten to take a long long.
+// Throws EngineError naming the token and `what` (e.g. "an integer field") otherwise.
+std::string integer_format(const std::string& token, const std::string& what);
+
+// `value` printed with a format returned by integer_format.
+std::string integer_text(const std::string& format, long long value);
+
 }  // namespace dem

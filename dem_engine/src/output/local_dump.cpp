@@ -8,6 +8,7 @@
 #include "core/simulation.h"
 #include "deck/errors.h"
 #include "deck/line_lexer_internal.h"
+#include "output/dump_fields.h"
 #include "output/output_file.h"
 
 namespace dem {
@@ -63,48 +64,8 @@ void check_column(const Simulation& sim, const LocalDumpColumn& column) {
                       (n == 1 ? " column)" : " columns)"));
 }
 
-// The printf format of the index column: exactly one %[flags][width]d|i conversion (plus literal
-// text and %%), rewritten to take a long long.
-std::string index_format(const std::string& token) {
-  std::string out;
-  int conversions = 0;
-  for (std::size_t i = 0; i < token.size();) {
-    if (token[i] != '%') {
-      out += token[i++];
-    } else if (i + 1 < token.size() && token[i + 1] == '%') {
-      out += "%%";
-      i += 2;
-    } else {
-      std::size_t j = i + 1;
-      while (j < token.size() && std::string("-+ 0#").find(token[j]) != std::string::npos) ++j;
-      while (j < token.size() && token[j] >= '0' && token[j] <= '9') ++j;
-      if (j >= token.size() || (token[j] != 'd' && token[j] != 'i'))
-        throw EngineError("dump_modify format '" + token +
-                          "': the index column needs one %d conversion");
-      out += token.substr(i, j - i) + "lld";
-      i = j + 1;
-      ++conversions;
-    }
-  }
-  if (conversions != 1)
-    throw EngineError("dump_modify format '" + token +
-                      "': the index column needs exactly one %d conversion");
-  return out;
-}
-
 std::string index_text(const std::string& format, long long value) {
-  if (format.empty()) return format_integer(value);
-  char buffer[128];
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wformat-nonliteral"
-#endif
-  // `format` was checked by index_format to hold one long long conversion.
-  std::snprintf(buffer, sizeof buffer, format.c_str(), value);
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
-  return buffer;
+  return format.empty() ? format_integer(value) : integer_text(format, value);
 }
 
 }  // namespace
@@ -151,22 +112,11 @@ void DumpLocal::modify(const std::vector<std::string>& args) {
 void DumpLocal::set_format(const std::string& text) {
   formats_.clear();
   if (text == "none") return;
-  std::vector<std::string> tokens;
-  std::size_t i = 0;
-  while (i < text.size()) {
-    while (i < text.size() && text[i] == ' ') ++i;
-    std::size_t j = i;
-    while (j < text.size() && text[j] != ' ') ++j;
-    if (j > i) tokens.push_back(text.substr(i, j - i));
-    i = j;
-  }
-  if (tokens.size() < columns_.size())
-    throw EngineError("dump_modify format string is too short (" + std::to_string(tokens.size()) +
-                      " formats for " + std::to_string(columns_.size()) + " columns)");
+  const std::vector<std::string> tokens = format_tokens(text, columns_.size(), "columns");
   std::vector<std::string> formats;
   for (std::size_t k = 0; k < columns_.size(); ++k) {
     if (columns_[k].is_index()) {
-      formats.push_back(index_format(tokens[k]));
+      formats.push_back(integer_format(tokens[k], "the index column"));
     } else {
       deck_lexer::format_number(tokens[k], 0.0);  // validates: one floating-point conversion
       formats.push_back(tokens[k]);
