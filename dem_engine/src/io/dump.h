@@ -29,6 +29,8 @@ class Dump {
   std::string file_;                // may contain '*' (replaced by the step number)
   std::vector<std::string> args_;   // words after FILE
   std::uint32_t group_bit_ = 1;
+  bool first_ = false;  // dump_modify first: write at the first step of a run too
+  int pad_ = 0;         // dump_modify pad: digits of the step in a '*' file name
 
  private:
   std::string id_, style_;

@@ -26,16 +26,10 @@ void AtomDump::modify(const std::vector<std::string>& args) {
     const std::string& key = args[i];
     if (i + 1 >= args.size()) throw EngineError("dump_modify keyword '" + key + "' needs a value");
     const std::string& value = args[i + 1];
-    if (key == "first") {
-      first_ = parse_yes_no(value, "dump_modify first");
-    } else if (key == "sort") {
+    if (key == "sort") {
       if (value != "id" && value != "off")
         throw EngineError("dump_modify sort '" + value + "' is not supported (id or off)");
       sort_ = value == "id";
-    } else if (key == "pad") {
-      const long pad = parse_int(value, "dump_modify pad");
-      if (pad < 0 || pad > 30) throw EngineError("dump_modify pad must be in 0..30");
-      pad_ = static_cast<int>(pad);
     } else if (key == "format") {
       if (!accepts_format())
         throw EngineError("dump_modify format is only supported for dump custom");

@@ -40,8 +40,7 @@ class AtomDump : public Dump {
   std::string expand(long step) const;
   static constexpr long kNever = -1;
   long last_written_ = kNever;
-  bool first_ = false, sort_ = false;
-  int pad_ = 0;
+  bool sort_ = false;
 };
 
 // `dump ID group custom N FILE fields...`: LAMMPS text snapshots (ITEM: TIMESTEP, NUMBER OF

@@ -19,9 +19,20 @@ Dump::Dump(Simulation& sim, const Command& command) : sim_(sim) {
   args_.assign(command.args.begin() + 5, command.args.end());
 }
 
+// The keywords every dump style shares; the styles handle theirs and pass the rest here.
 void Dump::modify(const std::vector<std::string>& args) {
   for (std::size_t i = 0; i < args.size(); i += 2) {
     const std::string& key = args[i];
+    if ((key == "first" || key == "pad") && i + 1 < args.size()) {
+      if (key == "first") {
+        first_ = parse_yes_no(args[i + 1], "dump_modify first");
+      } else {
+        const long pad = parse_int(args[i + 1], "dump_modify pad");
+        if (pad < 0 || pad > 30) throw EngineError("dump_modify pad must be in 0..30");
+        pad_ = static_cast<int>(pad);
+      }
+      continue;
+    }
     if (key != "every")
       throw EngineError("dump_modify: keyword '" + key + "' is not supported for dump " + id_ +
                         " (" + style_ + ")");

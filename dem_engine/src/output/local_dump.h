@@ -49,8 +49,6 @@ class DumpLocal : public Dump {
   std::ofstream stream_;              // single-file mode
   static constexpr long kNever = -1;
   long last_written_ = kNever;
-  bool first_ = false;
-  int pad_ = 0;
 };
 
 }  // namespace dem
