@@ -14,7 +14,7 @@ include: "workflow/rules/common.smk"
 wildcard_constraints:
     test="shear_cell|angle_of_repose",
     case=r"[A-Za-z0-9]+(_s\d+(_p\d+)?)?",
-    stage="cases|verification/[a-z][a-z0-9_]*|discrepancy/probes|discrepancy/extended|discrepancy/verification",
+    stage="cases|verification/[a-z][a-z0-9_]*|sequential/round_[0-9]+/verification|discrepancy/probes|discrepancy/extended|discrepancy/verification",
     engine="[a-z][a-z0-9_]*",
     output="mu_psh|mu_sh|rho_b|aor",
 
@@ -26,6 +26,11 @@ include: "workflow/rules/surrogate.smk"
 include: "workflow/rules/identify.smk"
 include: "workflow/rules/application.smk"
 include: "workflow/rules/discrepancy.smk"
+
+
+if SEQUENTIAL:
+
+    include: "workflow/rules/sequential.smk"
 
 
 rule all:
@@ -44,3 +49,5 @@ rule all:
         segregation_index=f"{RESULTS}/application/segregation_index.json",
         fig10=f"{RESULTS}/application/fig10_layout.png",
         fig11=f"{RESULTS}/application/fig11_segregation.png",
+        # a sequential study also reports its rounds
+        **({"rounds": f"{RESULTS}/sequential/rounds.md"} if SEQUENTIAL else {}),

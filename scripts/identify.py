@@ -2,9 +2,15 @@
 
 from demcal.core.rule_log import rule_log
 from demcal.identification.identify import IdentificationFiles, identify
+from demcal.sequential.round_steps import take_over
 
 
 def main(snakemake) -> None:
+    if getattr(snakemake.input, "screened", None):
+        with rule_log(snakemake.log[0]) as logger:
+            source = take_over(snakemake.input.screened, snakemake.output.identified)
+            logger.info("the last round's screening and identified set (%s)", source)
+        return
     with rule_log(snakemake.log[0]) as logger:
         result = identify(
             dict(zip(snakemake.params.outputs, snakemake.input.models, strict=True)),

@@ -1,16 +1,16 @@
 """Run time of every DEM case of the study, from the engine rules' benchmark files."""
 
+from pathlib import Path
+
 from demcal.bulk.run_times import write_run_times
 from demcal.core.rule_log import rule_log
 
 
 def main(snakemake) -> None:
     with rule_log(snakemake.log[0]) as logger:
+        # .../benchmarks/cases/<test>/<case>.tsv
         benchmarks = [
-            (test, case, path)
-            for (test, case), path in zip(
-                snakemake.params.cases, snakemake.input.benchmarks, strict=True
-            )
+            (Path(path).parent.name, Path(path).stem, path) for path in snakemake.input.benchmarks
         ]
         table = write_run_times(benchmarks, snakemake.output.table, snakemake.output.figure)
         logger.info(

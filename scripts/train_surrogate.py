@@ -1,11 +1,17 @@
 """Train the network of one bulk value with its baselines (Snakemake script)."""
 
 from demcal.core.rule_log import rule_log
+from demcal.sequential.round_steps import take_over
 from demcal.surrogates.training import train_from_dataset
 
 
 def main(snakemake) -> None:
     output = snakemake.wildcards.output
+    if getattr(snakemake.input, "trained", None):
+        with rule_log(snakemake.log[0]) as logger:
+            source = take_over(snakemake.input.trained, snakemake.output.model)
+            logger.info("%s: the last round's network and Table 4 rows (%s)", output, source)
+        return
     with rule_log(snakemake.log[0]) as logger:
         trained = train_from_dataset(
             snakemake.input.dataset,

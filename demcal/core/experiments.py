@@ -99,6 +99,14 @@ class Experiment:
     angle_of_repose: float | None = None
     angle_of_repose_sd: float | None = None
 
+    @property
+    def outputs(self) -> list[str]:
+        """The bulk values measured at least once, shear-cell values first, no repeats."""
+        names = [name for cond in self.shear_conditions for name in cond.values]
+        if self.angle_of_repose is not None:
+            names.append("aor")
+        return list(dict.fromkeys(names))
+
 
 def load_experiment(path: str | Path) -> Experiment:
     """Read and validate an experiment file.

@@ -133,6 +133,7 @@ def verification_case(
     if not params:
         raise ValueError("no parameter set was identified; nothing to verify")
     row: dict[str, Any] = {"case_id": key, **{k: float(v["mean"]) for k, v in params.items()}}
+    row["seed"] = replicate_seed(config, key)
     if test == "shear_cell":
         row.update(load_condition(config, key))
     return row
@@ -166,8 +167,36 @@ def verification_threads(config: Mapping[str, Any]) -> int:
     return int(threads if threads is not None else config["engine"]["threads"])
 
 
+#: Seed offset between replicate verification runs (replicate k uses seed + k x this).
+REPLICATE_SEED_STEP = 1000
+_REPLICATE_KEY = re.compile(r"identified(?P<k>\d*)(_s\d+(_p\d+)?)?")
+
+
+def verification_bases(config: Mapping[str, Any]) -> list[str]:
+    """Base ids of the replicate verification runs: ``identified``, ``identified2``, ..."""
+    seeds = int((config.get("verification") or {}).get("seeds", 1))
+    return ["identified"] + [f"identified{k}" for k in range(2, seeds + 1)]
+
+
 def verification_case_ids(config: Mapping[str, Any], test: str) -> list[str]:
-    """Ids of the verification runs at the identified set."""
+    """Ids of the verification runs at the identified set (every replicate, every load)."""
+    bases = verification_bases(config)
     if test == "angle_of_repose":
-        return ["identified"]
-    return [f"identified{suffix}" for suffix in shear_suffixes(config)]
+        return bases
+    return [f"{base}{suffix}" for base in bases for suffix in shear_suffixes(config)]
+
+
+def replicate_seed(config: Mapping[str, Any], key: str) -> int:
+    """Insertion seed of the verification run ``key``: the master seed for replicate 1, then
+    ``seed + (k - 1) * REPLICATE_SEED_STEP`` for ``identified<k>``.
+
+    Raises
+    ------
+    KeyError
+        When ``key`` is not a verification case id.
+    """
+    match = _REPLICATE_KEY.fullmatch(key)
+    if match is None:
+        raise KeyError(f"{key!r} is not a verification case id")
+    k = int(match.group("k") or 1)
+    return int(config["seed"]) + (k - 1) * REPLICATE_SEED_STEP

@@ -155,13 +155,17 @@ def calibrate(
     return CalibrationResult(axes, valid, n_total, elapsed, table5, identified, chosen or "")
 
 
+def valid_sets_file(out_dir: str | Path, group: str) -> Path:
+    """Where the valid sets of ``group`` go (``valid_ssc_aor.csv.gz`` for "SSC & AoR")."""
+    name = group.lower().replace(" & ", "_").replace(" ", "_")
+    return Path(out_dir) / f"valid_{name}.csv.gz"
+
+
 def write_valid_sets(result: CalibrationResult, out_dir: str | Path) -> dict[str, Path]:
-    """Valid sets per group as compressed CSV (``valid_<group>.csv.gz``)."""
-    out_dir = Path(out_dir)
+    """Valid sets per group as compressed CSV (:func:`valid_sets_file`)."""
     paths = {}
     for group, frame in result.valid.items():
-        name = group.lower().replace(" & ", "_").replace(" ", "_")
-        path = out_dir / f"valid_{name}.csv.gz"
+        path = valid_sets_file(out_dir, group)
         frame.to_csv(path, index=False, float_format="%.6g")
         paths[group] = path
     return paths

@@ -21,6 +21,11 @@ def engine_columns(engine: str) -> tuple[str, str, str]:
     return f"dem_{engine}", f"deviation_{engine}", f"within_tolerance_{engine}"
 
 
+def scatter_columns(engine: str) -> tuple[str, str]:
+    """Columns of one engine's replicate scatter: standard deviation and number of runs."""
+    return f"dem_sd_{engine}", f"runs_{engine}"
+
+
 def _observations(experiment: Experiment) -> list[dict]:
     """The measured observables in table order: name, load, measured value and sd."""
     rows = []
@@ -50,18 +55,22 @@ def _observations(experiment: Experiment) -> list[dict]:
     return rows
 
 
-def _dem_value(runs: pd.DataFrame, row: Mapping) -> float:
-    """The DEM value of the observable of ``row`` in ``runs`` (NaN when no run matches)."""
+def _dem_values(runs: pd.DataFrame, row: Mapping) -> np.ndarray:
+    """The DEM values of the observable of ``row`` in ``runs``, one per replicate run that
+    finished (empty when none matches)."""
     name = row["observable"]
     if name == "aor":
-        aor = runs[runs["test"] == "angle_of_repose"]
-        return float(aor["aor"].iloc[0]) if len(aor) else math.nan
-    shear = runs[runs["test"] == "shear_cell"]
-    stress, p = row["normal_stress"], row["P"]
-    match = shear[
-        (shear["normal_stress"] - stress).abs().lt(1e-6 * stress) & (shear["P"] - p).abs().lt(1e-9)
-    ]
-    return float(match[name].iloc[0]) if len(match) and name in match else math.nan
+        values = runs.loc[runs["test"] == "angle_of_repose", "aor"]
+    else:
+        shear = runs[runs["test"] == "shear_cell"]
+        stress, p = row["normal_stress"], row["P"]
+        match = shear[
+            (shear["normal_stress"] - stress).abs().lt(1e-6 * stress)
+            & (shear["P"] - p).abs().lt(1e-9)
+        ]
+        values = match[name] if name in match else pd.Series(dtype=float)
+    values = values.to_numpy(dtype=float)
+    return values[np.isfinite(values)]
 
 
 def verification_table(
@@ -83,8 +92,10 @@ def verification_table(
     -------
     pandas.DataFrame
         Columns ``observable``, ``normal_stress``, ``P``, ``measured``, ``measured_sd``, then per
-        engine ``dem_<engine>``, ``deviation_<engine>`` (|1 - dem/measured|) and
-        ``within_tolerance_<engine>``; with two engines or more, ``engine_difference``: the
+        engine ``dem_<engine>`` (the mean over its replicate runs), ``dem_sd_<engine>`` (their
+        sample standard deviation, NaN for one run), ``runs_<engine>`` (how many finished),
+        ``deviation_<engine>`` (|1 - dem/measured|) and ``within_tolerance_<engine>``; with two
+        engines or more, ``engine_difference``: the
         largest |1 - dem_other/dem_first| over the other engines, NaN when a value is missing
         (or the first engine's value is 0).
         A missing DEM value (no run at that load) is NaN and never within the tolerance.
@@ -96,10 +107,14 @@ def verification_table(
         values = []
         for engine, frame in runs.items():
             value, deviation, within = engine_columns(engine)
-            dem = _dem_value(frame, row)
+            sd, count = scatter_columns(engine)
+            replicates = _dem_values(frame, row)
+            dem = float(np.mean(replicates)) if replicates.size else math.nan
+            row[value] = dem
+            row[sd] = float(np.std(replicates, ddof=1)) if replicates.size > 1 else math.nan
+            row[count] = int(replicates.size)
             name = row["observable"]
             accepted = within_tolerance({name: np.array([dem])}, {name: row["measured"]}, tolerance)
-            row[value] = dem
             row[deviation] = float(relative_deviation(dem, row["measured"]))
             row[within] = bool(accepted[0])
             values.append(dem)

@@ -103,7 +103,10 @@ def write_verification_table(
         verdict = json.loads(Path(identified).read_text()).get("reach")
         if verdict:
             lines = [verdict, "", *lines]
-    lines.append("Engines (columns dem_<engine>, deviation_<engine> = |1 - dem/measured|):")
+    lines.append(
+        "Engines (columns dem_<engine>: mean over replicate runs, dem_sd_<engine>: their standard "
+        "deviation, runs_<engine>: runs that finished, deviation_<engine> = |1 - dem/measured|):"
+    )
     for engine in runs:
         command = (commands or {}).get(engine)
         ranks = f", {threads} thread(s) or MPI rank(s)" if threads is not None else ""

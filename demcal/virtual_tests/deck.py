@@ -209,7 +209,8 @@ def render_case(
     dCylDp = float(plain.get("dCylDp", section["dCylDp"]))
     dist = size_distribution(settings["particles"])
     mat = material_setup(plain, material, dist, youngs)
-    seed = int(settings["seed"])
+    # A replicate run (verification) carries its own insertion seed.
+    seed = int(plain.get("seed", settings["seed"]))
     skin = float(settings["material"]["skin"])
     if test == "shear_cell":
         # A case row with a load condition P runs that single cycle.

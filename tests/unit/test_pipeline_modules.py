@@ -13,7 +13,15 @@ import yaml
 from demcal.bulk.dataset import case_rows, collect, usable
 from demcal.core.config import ConfigError, validate_config
 from demcal.core.experiments import Experiment, MeasuredCondition, load_experiment
-from demcal.design.cases import case_ids, case_row, design_from_config, verification_case
+from demcal.design.cases import (
+    REPLICATE_SEED_STEP,
+    case_ids,
+    case_row,
+    design_from_config,
+    replicate_seed,
+    verification_case,
+    verification_case_ids,
+)
 from demcal.engine_io.run import engine_command, run_deck
 from demcal.identification.calibration import ConstantInputs, calibrate
 from demcal.identification.verification import verification_table
@@ -55,7 +63,25 @@ def test_verification_case_uses_identified_means(config):
         "coefficientFriction": 0.5,
         "normal_stress": config["shear_cell"]["normal_stresses"][1],
         "P": config["shear_cell"]["P"][3],
+        "seed": config["seed"],
     }
+    # Replicate 3 of a three-seed verification: same set and load, its own insertion seed.
+    third = verification_case(config, identified, "shear_cell", "identified3_s2_p4")
+    assert third["seed"] == config["seed"] + 2 * REPLICATE_SEED_STEP
+    assert {k: v for k, v in third.items() if k not in ("seed", "case_id")} == {
+        k: v for k, v in row.items() if k not in ("seed", "case_id")
+    }
+    replicated = {**config, "verification": {"seeds": 3}}
+    assert verification_case_ids(replicated, "angle_of_repose") == [
+        "identified",
+        "identified2",
+        "identified3",
+    ]
+    assert len(verification_case_ids(replicated, "shear_cell")) == 3 * len(
+        verification_case_ids(config, "shear_cell")
+    )
+    with pytest.raises(KeyError, match="not a verification case"):
+        replicate_seed(config, "c0001")
     with pytest.raises(ValueError, match="no parameter set"):
         verification_case(config, {"parameters": {}}, "angle_of_repose", "identified")
 
@@ -282,6 +308,33 @@ def test_verification_table():
     assert "engine_difference" not in table  # one engine: nothing to compare
 
 
+def test_verification_table_averages_replicates():
+    """Three seeds at the identified set: the table compares their mean with the measurement
+    and gives their scatter; a failed replicate (NaN) is left out and counted."""
+    runs = pd.DataFrame(
+        {
+            "test": ["angle_of_repose"] * 3 + ["shear_cell"] * 3,
+            "normal_stress": [math.nan] * 3 + [2029.0] * 3,
+            "P": [math.nan] * 3 + [1.0] * 3,
+            "aor": [36.0, 38.0, 40.0, math.nan, math.nan, math.nan],
+            "rho_b": [math.nan] * 3 + [1700.0, math.nan, 1740.0],
+        }
+    )
+    exp = Experiment(
+        "m",
+        "",
+        [MeasuredCondition(values={"rho_b": 1760.0}, normal_stress=2029.0, P=1.0)],
+        angle_of_repose=38.85,
+    )
+    table = verification_table({"configured": runs}, exp, 0.05).set_index("observable")
+    assert table.loc["aor", "dem_configured"] == pytest.approx(38.0)
+    assert table.loc["aor", "dem_sd_configured"] == pytest.approx(2.0)
+    assert table.loc["aor", "runs_configured"] == 3
+    assert table.loc["rho_b", "dem_configured"] == pytest.approx(1720.0)
+    assert table.loc["rho_b", "runs_configured"] == 2
+    assert bool(table.loc["aor", "within_tolerance_configured"])
+
+
 def test_verification_table_two_engines_side_by_side(tmp_path):
     """The identified set on the bundled engine and on LIGGGHTS, each against the measurement
     and against each other (values of a tiny-profile run)."""
@@ -314,9 +367,13 @@ def test_verification_table_two_engines_side_by_side(tmp_path):
         "measured",
         "measured_sd",
         "dem_bundled",
+        "dem_sd_bundled",
+        "runs_bundled",
         "deviation_bundled",
         "within_tolerance_bundled",
         "dem_liggghts",
+        "dem_sd_liggghts",
+        "runs_liggghts",
         "deviation_liggghts",
         "within_tolerance_liggghts",
         "engine_difference",

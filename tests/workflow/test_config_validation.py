@@ -86,3 +86,17 @@ def test_misspelt_contact_parameter_stops_a_real_run_before_any_job(tmp_path):
     assert "Job stats" not in out and "rule design" not in out
     assert not (work / "results").exists()
     assert not (work / "logs").exists()
+
+
+def test_sequential_study_without_a_box_stops_workflow(tmp_path):
+    """A sequential study needs a sampled round 0: a factorial design is refused by name."""
+    res = _dry_run(
+        tmp_path,
+        {
+            "design": {"kind": "factorial", "levels": {"coefficientFriction": [0.2, 0.6]}},
+            "sequential": {"enabled": True},
+        },
+    )
+    assert res.returncode != 0
+    assert "sequential.enabled" in res.stderr + res.stdout
+    assert "design.kind" in res.stderr + res.stdout

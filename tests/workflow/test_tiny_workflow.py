@@ -49,14 +49,20 @@ def snakemake(workdir: Path, *args: str, timeout: float = 1500) -> subprocess.Co
     )
 
 
+def scratch_study(work: Path, config: dict) -> Path:
+    """A study directory: copies of the repo's config, templates and workflow, and ``config``
+    as ``config.yaml``."""
+    for item in ("config", "templates", "workflow"):
+        shutil.copytree(ROOT / item, work / item)
+    (work / "config.yaml").write_text(yaml.safe_dump(config))
+    return work
+
+
 @pytest.fixture(scope="module")
 def study(tmp_path_factory):
     """Run the tiny study once in a scratch directory (the repo's config and templates)."""
-    work = tmp_path_factory.mktemp("tiny_study")
-    for item in ("config", "templates", "workflow"):
-        shutil.copytree(ROOT / item, work / item)
     config = yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text())
-    (work / "config.yaml").write_text(yaml.safe_dump(config))
+    work = scratch_study(tmp_path_factory.mktemp("tiny_study"), config)
     res = snakemake(work)
     assert res.returncode == 0, res.stderr[-6000:]
     return work

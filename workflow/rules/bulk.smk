@@ -2,34 +2,36 @@
 # times of the DEM cases.
 
 
-rule collect_dataset:
-    input:
-        bulk=[
-            f"{RESULTS}/cases/{test}/{case}/bulk.csv" for test in TESTS for case in CASES[test]
-        ],
-    output:
-        dataset=report(DATASET, category="Bulk values", caption="../report/dataset.rst"),
-        failed=report(
-            f"{RESULTS}/bulk/failed_cases.csv",
-            category="Bulk values",
-            caption="../report/failed_cases.rst",
-        ),
-    log:
-        f"{LOGS}/bulk/collect_dataset.log",
-    resources:
-        runtime=resource("analysis", "runtime", 10),
-    conda:
-        CONDA_ENV
-    script:
-        "../../scripts/collect_dataset.py"
+if not SEQUENTIAL:
+    # (a sequential study writes the dataset after its last round: sequential.smk)
+    rule collect_dataset:
+        input:
+            bulk=[
+                f"{RESULTS}/cases/{test}/{case}/bulk.csv" for test in TESTS for case in CASES[test]
+            ],
+        output:
+            dataset=report(DATASET, category="Bulk values", caption="../report/dataset.rst"),
+            failed=report(
+                f"{RESULTS}/bulk/failed_cases.csv",
+                category="Bulk values",
+                caption="../report/failed_cases.rst",
+            ),
+        log:
+            f"{LOGS}/bulk/collect_dataset.log",
+        resources:
+            runtime=resource("analysis", "runtime", 10),
+        conda:
+            CONDA_ENV
+        script:
+            "../../scripts/collect_dataset.py"
 
 
 rule run_times:
     input:
-        benchmarks=[
+        benchmarks=lambda wildcards: [
             CASE_BENCHMARK.format(stage="cases", test=test, case=case)
             for test in TESTS
-            for case in CASES[test]
+            for case in study_case_ids(test)
         ],
     output:
         table=report(
@@ -40,8 +42,6 @@ rule run_times:
         ),
     log:
         f"{LOGS}/bulk/run_times.log",
-    params:
-        cases=[[test, case] for test in TESTS for case in CASES[test]],
     localrule: True
     conda:
         CONDA_ENV

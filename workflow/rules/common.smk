@@ -1,6 +1,10 @@
 # Shared set-up: validated configuration, the case list and output locations.
+import json
+from pathlib import Path
+
 from demcal.core.parameters import TESTS
 from demcal.design.cases import (
+    CONFIGURED_ENGINE,
     case_ids,
     case_row,
     design_from_config,
@@ -9,6 +13,11 @@ from demcal.design.cases import (
     verification_threads,
 )
 from demcal.core.config import validate_config
+from demcal.core.experiments import load_experiment
+from demcal.core.rule_log import rule_log
+from demcal.design.table import read_design_table
+from demcal.virtual_tests.deck import render_case
+from demcal.sequential.rounds import check_sequential, round_case_ids, round_of_case
 
 validate_config(config, source=", ".join(str(f) for f in workflow.configfiles) or "config")
 
@@ -29,6 +38,114 @@ VERIFICATION_CASES = {test: verification_case_ids(config, test) for test in TEST
 # results/verification/<name>/.
 VERIFICATION_ENGINES = verification_engines(config)
 VERIFICATION_THREADS = verification_threads(config)
+# The networks' inputs that the screening holds at the study's value.
+NETWORK_CONSTANTS = {
+    "mu_psh": {"dCylDp": config["shear_cell"]["dCylDp"]},
+    "mu_sh": {"dCylDp": config["shear_cell"]["dCylDp"]},
+    "rho_b": {"dCylDp": config["shear_cell"]["dCylDp"]},
+    "aor": {"dCylDp": config["angle_of_repose"]["dCylDp"]},
+}
+# A sequential study runs its design in rounds (sequential.smk); checked before any work starts.
+SEQUENTIAL = bool(config["sequential"]["enabled"])
+# The rounds train only the networks of measured values (the others once, after the last round).
+ROUND_OUTPUTS = OUTPUTS_TRAINED
+if SEQUENTIAL:
+    check_sequential(config)
+    ROUND_OUTPUTS = [
+        o for o in OUTPUTS_TRAINED if o in load_experiment(config["experiment"]).outputs
+    ]
+SEQ = f"{RESULTS}/sequential"
+SEQ_ROUND = f"{SEQ}/round_{{round}}"
+
+
+def case_design(wildcards):
+    """The design table of a case that a later round of a sequential study chose (none for the
+    configured design, which is known when the workflow is parsed)."""
+    if SEQUENTIAL:
+        round_no = round_of_case(config, wildcards.case.split("_s")[0])
+        if round_no > 0:
+            return {"design": round_path(round_no, "design.csv")}
+    return {}
+
+
+def render_study_case(wildcards, rule_input, deck, log):
+    """Render one DEM case of the study from its design row (its round's design table, or the
+    configured design) into the directory of ``deck``."""
+    design = read_design_table(rule_input.design) if "design" in rule_input.keys() else DESIGN
+    with rule_log(log):
+        case = case_row(config, design, wildcards.test, wildcards.case)
+        render_case(wildcards.test, case, config, Path(deck).parent)
+
+
+def study_case_ids(test):
+    """Ids of every DEM case of one test in the study (all rounds of a sequential one)."""
+    if not SEQUENTIAL:
+        return CASES[test]
+    return [c for r in range(last_round() + 1) for c in round_case_ids(config, r, test)]
+
+
+def round_path(round_no, name):
+    """A file of round ``round_no`` of a sequential study."""
+    return f"{SEQ}/round_{round_no}/{name}"
+
+
+def previous_round(wildcards, name):
+    """File ``name`` of the round before ``wildcards.round`` (none before round 0)."""
+    round_no = int(wildcards.round)
+    return [round_path(round_no - 1, name)] if round_no > 0 else []
+
+
+def round_case_bulk(round_no):
+    """bulk.csv of every DEM case of round ``round_no``."""
+    return [
+        f"{RESULTS}/cases/{test}/{case}/bulk.csv"
+        for test in TESTS
+        for case in round_case_ids(config, round_no, test)
+    ]
+
+
+def round_verification_bulk(round_no):
+    """bulk.csv of round ``round_no``'s verification runs; none when it identified nothing."""
+    if round_no < 0:
+        return []
+    identified = checkpoints.sequential_identify.get(round=round_no).output.identified
+    if not json.loads(Path(identified).read_text()).get("parameters"):
+        return []
+    return [
+        round_path(round_no, f"verification/{test}/{case}/bulk.csv")
+        for test in TESTS
+        for case in VERIFICATION_CASES[test]
+    ]
+
+
+def last_round():
+    """The round whose record says stop (checkpoints: known once the rounds have run)."""
+    round_no = 0
+    while True:
+        record = checkpoints.sequential_state.get(round=round_no).output.record
+        if json.loads(Path(record).read_text())["stop"]:
+            return round_no
+        round_no += 1
+
+
+def verification_bulk_files(engine):
+    """bulk.csv of the verification runs of ``engine`` (call from an input function). A
+    sequential study verified its last round's identified set with engine.command already:
+    those runs are reused."""
+    if SEQUENTIAL and engine == CONFIGURED_ENGINE:
+        return round_verification_bulk(last_round())
+    return [
+        f"{RESULTS}/verification/{engine}/{test}/{case}/bulk.csv"
+        for test in TESTS
+        for case in VERIFICATION_CASES[test]
+    ]
+
+
+def verified_set(wildcards):
+    """The identified set that the verification runs used."""
+    if SEQUENTIAL:
+        return round_path(last_round(), "identification/identified_parameters.json")
+    return IDENTIFIED
 
 
 def engine_command(stage):

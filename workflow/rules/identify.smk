@@ -16,6 +16,12 @@ rule identify:
         experiment=config["experiment"],
         # for the first line of Table 5: can the model reach the measurement at all?
         dataset=DATASET,
+        # A sequential study screened with these networks in its last round: taken over.
+        screened=lambda wc: (
+            round_path(last_round(), "identification/identified_parameters.json")
+            if SEQUENTIAL
+            else []
+        ),
     output:
         table5=report(
             f"{RESULTS}/identification/table5.md",
@@ -38,12 +44,7 @@ rule identify:
     params:
         outputs=OUTPUTS_TRAINED,
         screening=config["screening"],
-        constants={
-            "mu_psh": {"dCylDp": config["shear_cell"]["dCylDp"]},
-            "mu_sh": {"dCylDp": config["shear_cell"]["dCylDp"]},
-            "rho_b": {"dCylDp": config["shear_cell"]["dCylDp"]},
-            "aor": {"dCylDp": config["angle_of_repose"]["dCylDp"]},
-        },
+        constants=NETWORK_CONSTANTS,
     threads: config["screening"]["threads"]
     resources:
         runtime=resource("training", "runtime", 30),
@@ -73,15 +74,11 @@ rule verification_table:
     input:
         # One list of bulk files per engine, named bulk_<engine>.
         **{
-            f"bulk_{engine}": [
-                f"{RESULTS}/verification/{engine}/{test}/{case}/bulk.csv"
-                for test in TESTS
-                for case in VERIFICATION_CASES[test]
-            ]
+            f"bulk_{engine}": lambda wildcards, engine=engine: verification_bulk_files(engine)
             for engine in VERIFICATION_ENGINES
         },
         experiment=config["experiment"],
-        identified=IDENTIFIED,
+        identified=verified_set,
     output:
         table=report(
             f"{RESULTS}/verification/verification.md",
@@ -114,8 +111,11 @@ VERIFICATION_PICTURES = {
 rule verification_pictures:
     input:
         **{
-            test: f"{RESULTS}/verification/{next(iter(VERIFICATION_ENGINES))}/{test}/"
-            f"{VERIFICATION_CASES[test][0]}/bulk.csv"
+            test: lambda wildcards, test=test: next(
+                path
+                for path in verification_bulk_files(next(iter(VERIFICATION_ENGINES)))
+                if f"/{test}/{VERIFICATION_CASES[test][0]}/" in path
+            )
             for test in TESTS
         },
     output:

@@ -1,25 +1,20 @@
 # Stage 2: render one deck per DEM case, run it with the configured engine, extract its bulk
 # values.
-from pathlib import Path
-
 from demcal.bulk.dataset import write_case_rows
-from demcal.virtual_tests.deck import render_case
-from demcal.core.rule_log import rule_log
 
 
 rule render_case:
+    input:
+        unpack(case_design),
     output:
         deck=f"{RESULTS}/cases/{{test}}/{{case}}/in.{{test}}",
         info=f"{RESULTS}/cases/{{test}}/{{case}}/case.json",
     log:
         f"{LOGS}/render/{{test}}/{{case}}.log",
-    params:
-        case=lambda wc: case_row(config, DESIGN, wc.test, wc.case),
     localrule: True
     run:
         # In-process: a new interpreter per case would cost more than the rendering.
-        with rule_log(log[0]):
-            render_case(wildcards.test, params.case, config, Path(output.deck).parent)
+        render_study_case(wildcards, input, output.deck, log[0])
 
 
 # Wall-clock time, memory and CPU of every engine run (the study's cases: rule run_times).

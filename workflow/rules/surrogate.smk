@@ -5,6 +5,12 @@
 rule train_surrogate:
     input:
         dataset=DATASET,
+        # A sequential study trained these networks in its last round: they are taken over.
+        trained=lambda wc: (
+            round_path(last_round(), f"surrogates/{wc.output}/model.pt")
+            if SEQUENTIAL and wc.output in ROUND_OUTPUTS
+            else []
+        ),
     output:
         model=f"{RESULTS}/surrogates/{{output}}/model.pt",
         table4=f"{RESULTS}/surrogates/{{output}}/table4.csv",
