@@ -5,8 +5,9 @@ namespace dem {
 
 // No cohesion.
 struct CohesionNone {
-  static void apply(const ContactInput&, const PairParams&, const ContactStep&, double*,
-                    ContactResult&) {}
+  template <class R>
+  static void apply(const ContactInputT<R>&, const PairParamsT<R>&, const ContactStep&, R*,
+                    ContactResultT<R>&) {}
 };
 
 }  // namespace dem

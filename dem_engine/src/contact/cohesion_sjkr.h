@@ -11,19 +11,23 @@ namespace dem {
 // keeps the contact force alone unless `tangential_reduce on`, which subtracts the cohesive
 // force from it as well.
 struct CohesionSjkr {
-  static double contact_area(const ContactInput& c) {
+  template <class R>
+  static R contact_area(const ContactInputT<R>& c) {
     if (c.wall) return M_PI * (c.ri * c.ri - c.dist * c.dist);
-    const double r = c.dist;
-    const double prod =
+    const R r = c.dist;
+    const R prod =
         (r - c.ri - c.rj) * (r + c.ri - c.rj) * (r - c.ri + c.rj) * (r + c.ri + c.rj);
-    return 0.25 * M_PI * std::fabs(prod) / (r * r);
+    return 0.25 * M_PI * lane_abs(prod) / (r * r);
   }
-  static void apply(const ContactInput& c, const PairParams& p, const ContactStep& step,
-                    double* /*history*/, ContactResult& result) {
-    if (p.cohesion <= 0.0) return;
-    const double f = p.cohesion * contact_area(c);
-    result.fn -= f;
-    if (step.options.tangential_reduce) result.fn_limit -= f;
+  template <class R>
+  DEM_INLINE static void apply(const ContactInputT<R>& c, const PairParamsT<R>& p,
+                               const ContactStep& step, R* /*history*/, ContactResultT<R>& result) {
+    const auto cohesive = p.cohesion > 0.0;
+    if (!any(cohesive)) return;
+    const R f = p.cohesion * contact_area(c);
+    result.fn = select(cohesive, result.fn - f, result.fn);
+    if (step.options.tangential_reduce)
+      result.fn_limit = select(cohesive, result.fn_limit - f, result.fn_limit);
   }
 };
 

@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -75,9 +76,9 @@ void parse_pair_model(const std::vector<std::string>& w, std::size_t pos, ModelS
 
 namespace {
 
-template <class Cohesion, class Rolling>
-inline void contact_law(const ContactInput& c, const PairParams& p, const ContactStep& step,
-                        double* history, ContactResult& result) {
+template <class Cohesion, class Rolling, class R>
+DEM_INLINE void contact_law(const ContactInputT<R>& c, const PairParamsT<R>& p,
+                        const ContactStep& step, R* history, ContactResultT<R>& result) {
   NormalHertz::apply(c, p, step, history, result);
   Cohesion::apply(c, p, step, history, result);
   TangentialHistory::apply(c, p, step, history, result);
@@ -94,6 +95,13 @@ class ComposedModel final : public ContactModel {
     contact_law<Cohesion, Rolling>(c, p, step, history, result);
   }
 
+  void wall_forces(const Particles& P, const MaterialTable& material, const ContactStep& step,
+                   const WallContact* contacts, std::size_t count,
+                   ContactResult* results) const override {
+    for (std::size_t h = 0; h < count; h += kLanes)
+      wall_pack(P, material, step, contacts, h, h + 1 < count, results);
+  }
+
   void pair_forces(PairForceArgs& a) const override {
     const bool periodic = a.domain.periodic(0) || a.domain.periodic(1) || a.domain.periodic(2);
     if (periodic) loop<true>(a);
@@ -101,6 +109,174 @@ class ComposedModel final : public ContactModel {
   }
 
  private:
+  using Pack = Pack2;
+  static constexpr int kLanes = 2;
+  static constexpr int kBatch = 128;  // contacts per batch: its buffers stay in L1
+
+  // Touching pairs waiting for their contact law: particle i, its partner j, the list entry k,
+  // and the results (force on i, torque on i, torque on j, overlap), one array per component
+  // so that a pack of results is stored at once.
+  struct Batch {
+    // Kept per thread between steps (no allocations per step once large enough).
+    void reserve(int capacity) {
+      const auto size = static_cast<std::size_t>(capacity) + kLanes;
+      if (i.size() >= size) return;
+      i.resize(size);
+      j.resize(size);
+      k.resize(size);
+      for (auto& o : out) o.resize(size);
+    }
+    std::vector<int> i, j, k;
+    std::array<std::vector<double>, 10> out;
+    int size = 0;
+    // The material parameters of the last pack, reused while the type pairs repeat (always,
+    // with one particle type).
+    const PairParams* params_of[2] = {nullptr, nullptr};
+    PairParamsT<Pack> params;
+  };
+
+  // The contact law of batch entries e0 and e1 in one pack (e1 = e0 for a lone last contact,
+  // whose second lane is then dropped). Packs are filled straight from the particle arrays.
+  template <bool Periodic>
+  DEM_AVX_CLONES void contact_pack(const PairForceArgs& a, const ContactStep& step, Batch& b,
+                                   int e0, bool two) const {
+    const Particles& P = a.atoms;
+    const Vec3* x = P.x.data();
+    const Vec3* v = P.v.data();
+    const Vec3* w = P.omega.data();
+    const double* rad = P.radius.data();
+    const double* mass = P.rmass.data();
+    using V = Vec3T<Pack>;
+    const int e1 = two ? e0 + 1 : e0;
+    const auto i0 = static_cast<std::size_t>(b.i[e0]), i1 = static_cast<std::size_t>(b.i[e1]);
+    const auto j0 = static_cast<std::size_t>(b.j[e0]), j1 = static_cast<std::size_t>(b.j[e1]);
+    auto pack3 = [](const Vec3& p0, const Vec3& p1) {
+      return V{Pack(p0.x, p1.x), Pack(p0.y, p1.y), Pack(p0.z, p1.z)};
+    };
+    ContactInputT<Pack> c;
+    V d;
+    if constexpr (Periodic) {
+      d = pack3(a.domain.minimum_image(x[i0] - x[j0]), a.domain.minimum_image(x[i1] - x[j1]));
+    } else {
+      d = pack3(x[i0], x[i1]) - pack3(x[j0], x[j1]);
+    }
+    const Pack r = lane_sqrt(norm2(d));
+    c.ri = Pack(rad[i0], rad[i1]);
+    c.rj = Pack(rad[j0], rad[j1]);
+    const Pack radsum = c.ri + c.rj;
+    c.dist = r;
+    c.n = (1.0 / r) * d;
+    c.overlap = radsum - r;
+    c.r_eff = c.ri * c.rj / radsum;
+    Pack mi(mass[i0], mass[i1]), mj(mass[j0], mass[j1]);
+    if (a.freeze_bit) {  // rare: a pair with a frozen particle has the other's mass
+      double m[2][2] = {{mass[i0], mass[j0]}, {mass[i1], mass[j1]}};
+      const std::size_t ij[2][2] = {{i0, j0}, {i1, j1}};
+      for (int l = 0; l < 2; ++l) {
+        if (P.mask[ij[l][0]] & a.freeze_bit) m[l][0] = 0.0, m[l][1] = mass[ij[l][1]];
+        if (P.mask[ij[l][1]] & a.freeze_bit) m[l][0] = mass[ij[l][0]], m[l][1] = 0.0;
+      }
+      mi = Pack(m[0][0], m[1][0]);
+      mj = Pack(m[0][1], m[1][1]);
+    }
+    c.m_eff = m_effective(mi, mj, a.freeze_bit != 0);
+    c.cri = c.ri - 0.5 * c.overlap;
+    c.crj = c.rj - 0.5 * c.overlap;
+    c.v_rel = pack3(v[i0], v[i1]) - pack3(v[j0], v[j1]);
+    c.omega_i = pack3(w[i0], w[i1]);
+    c.omega_j = pack3(w[j0], w[j1]);
+    const PairParams* q0 = &a.material.get(P.type[i0], P.type[j0]);
+    const PairParams* q1 = &a.material.get(P.type[i1], P.type[j1]);
+    if (q0 != b.params_of[0] || q1 != b.params_of[1]) {
+      b.params = pack_params(*q0, *q1);
+      b.params_of[0] = q0;
+      b.params_of[1] = q1;
+    }
+    const PairParamsT<Pack>& p = b.params;
+    double* h0 = a.list.history.data() + static_cast<std::size_t>(b.k[e0]) * kHistorySize;
+    double* h1 = a.list.history.data() + static_cast<std::size_t>(b.k[e1]) * kHistorySize;
+    Pack hist[kHistorySize];
+    for (int q = 0; q < kHistorySize; ++q) hist[q] = Pack(h0[q], h1[q]);
+    ContactResultT<Pack> res;
+    contact_law<Cohesion, Rolling>(c, p, step, hist, res);
+    for (int q = 0; q < kHistorySize; ++q) h0[q] = hist[q][0];
+    if (two)
+      for (int q = 0; q < kHistorySize; ++q) h1[q] = hist[q][1];
+    // Whole packs are stored; a dropped lane lands in the spare entry past the batch.
+    const Pack* results[10] = {&res.force.x,    &res.force.y,    &res.force.z,
+                               &res.torque_i.x, &res.torque_i.y, &res.torque_i.z,
+                               &res.torque_j.x, &res.torque_j.y, &res.torque_j.z,
+                               &c.overlap};
+    for (int q = 0; q < 10; ++q) results[q]->store(&b.out[q][static_cast<std::size_t>(e0)]);
+  }
+
+  // Wall contacts e0 and e1 in one pack, set up as Simulation::wall_contact does (e1 = e0 for
+  // a lone last contact, whose second lane is dropped).
+  DEM_AVX_CLONES void wall_pack(const Particles& P, const MaterialTable& material,
+                                const ContactStep& step, const WallContact* contacts,
+                                std::size_t e0, bool two, ContactResult* results) const {
+    using V = Vec3T<Pack>;
+    const WallContact& w0 = contacts[e0];
+    const WallContact& w1 = contacts[two ? e0 + 1 : e0];
+    const std::size_t i0 = w0.i, i1 = w1.i;
+    auto pack3 = [](const Vec3& p0, const Vec3& p1) {
+      return V{Pack(p0.x, p1.x), Pack(p0.y, p1.y), Pack(p0.z, p1.z)};
+    };
+    ContactInputT<Pack> c;
+    c.wall = true;
+    c.n = pack3(w0.normal, w1.normal);
+    c.overlap = Pack(w0.overlap, w1.overlap);
+    c.dist = Pack(w0.dist, w1.dist);
+    c.ri = Pack(P.radius[i0], P.radius[i1]);
+    c.rj = 0.0;
+    c.r_eff = c.ri;
+    c.m_eff = Pack(P.rmass[i0], P.rmass[i1]);
+    c.cri = c.ri - 0.5 * c.overlap;
+    c.crj = 0.0;
+    c.v_rel = pack3(P.v[i0], P.v[i1]) - pack3(w0.wall_velocity, w1.wall_velocity);
+    c.omega_i = pack3(P.omega[i0], P.omega[i1]);
+    c.omega_j = V{Pack(0.0), Pack(0.0), Pack(0.0)};
+    const PairParamsT<Pack> p = pack_params(material.get(P.type[i0], w0.wall_type),
+                                            material.get(P.type[i1], w1.wall_type));
+    Pack hist[kHistorySize];
+    for (int q = 0; q < kHistorySize; ++q) hist[q] = Pack(w0.history[q], w1.history[q]);
+    ContactResultT<Pack> res;
+    contact_law<Cohesion, Rolling>(c, p, step, hist, res);
+    const int lanes = two ? 2 : 1;
+    for (int l = 0; l < lanes; ++l) {
+      double* h = l == 0 ? w0.history : w1.history;
+      for (int q = 0; q < kHistorySize; ++q) h[q] = hist[q][l];
+      ContactResult& r = results[e0 + static_cast<std::size_t>(l)];
+      r.fn = res.fn[l];
+      r.fn_limit = res.fn_limit[l];
+      r.kn = res.kn[l];
+      r.kt = res.kt[l];
+      r.gamma_t = res.gamma_t[l];
+      r.force = Vec3{res.force.x[l], res.force.y[l], res.force.z[l]};
+      r.torque_i = Vec3{res.torque_i.x[l], res.torque_i.y[l], res.torque_i.z[l]};
+      r.torque_j = Vec3{res.torque_j.x[l], res.torque_j.y[l], res.torque_j.z[l]};
+    }
+  }
+
+  static PairParamsT<Pack> pack_params(const PairParams& p0, const PairParams& p1) {
+    PairParamsT<Pack> p;
+    p.y_star = Pack(p0.y_star, p1.y_star);
+    p.g_star = Pack(p0.g_star, p1.g_star);
+    p.beta = Pack(p0.beta, p1.beta);
+    p.mu_s = Pack(p0.mu_s, p1.mu_s);
+    p.mu_r = Pack(p0.mu_r, p1.mu_r);
+    p.cohesion = Pack(p0.cohesion, p1.cohesion);
+    return p;
+  }
+
+  // m_i m_j / (m_i + m_j); with fix freeze, a zero mass stands for a frozen particle and the
+  // effective mass is the other one's.
+  static Pack m_effective(const Pack& mi, const Pack& mj, bool freeze) {
+    const Pack m_eff = mi * mj / (mi + mj);
+    if (!freeze) return m_eff;
+    return select(mi > 0.0 && mj > 0.0, m_eff, mi + mj);
+  }
+
   template <bool Periodic>
   void loop(PairForceArgs& a) const {
     Particles& P = a.atoms;
@@ -114,16 +290,9 @@ class ComposedModel final : public ContactModel {
     long worst_tag = -1;
     long contacts = 0;
     const Vec3* x = P.x.data();
-    const Vec3* v = P.v.data();
-    const Vec3* w = P.omega.data();
     const double* rad = P.radius.data();
-    const double* mass = P.rmass.data();
-    const int* type = P.type.data();
-    const std::uint32_t* mask = P.mask.data();
-    const std::uint32_t freeze_bit = a.freeze_bit;
     const int* first = a.list.first.data();
     const int* partner = a.list.partner.data();
-    double* hist_all = a.list.history.data();
     std::uint8_t* touching = a.list.touching.data();
     const int max_pairs = a.list.max_pairs_per_particle();
     // Per thread: one past the largest particle index it adds forces to.
@@ -150,88 +319,92 @@ class ComposedModel final : public ContactModel {
         std::fill(f + own.begin, f + end_j, Vec3{});
         std::fill(t + own.begin, t + end_j, Vec3{});
       }
-      std::vector<int> hits(static_cast<std::size_t>(max_pairs));
-      std::vector<ContactInput> inputs(static_cast<std::size_t>(max_pairs));
+      // Contacts are gathered across particles into batches (pass 1), whose contact laws run
+      // kLanes contacts at a time on packs (pass 2); their forces are then added in the order
+      // of the list (pass 3), so the sums are those of one contact at a time.
+      const int capacity = std::max(kBatch, max_pairs);
+      static thread_local Batch batch;
+      batch.reserve(capacity);
+      batch.size = 0;
+      batch.params_of[0] = batch.params_of[1] = nullptr;  // the material table may have changed
       double my_ratio = 0.0;
       long my_tag = -1;
+      // Raw pointers in locals: the byte stores to `touching` may alias anything, which would
+      // make the compiler reload every pointer held in memory after each of them.
+      int* const bi = batch.i.data();
+      int* const bj = batch.j.data();
+      int* const bk = batch.k.data();
+      const double* out[10];
+      for (int q = 0; q < 10; ++q) out[q] = batch.out[static_cast<std::size_t>(q)].data();
+      const double* const fx = out[0];
+      const double* const fy = out[1];
+      const double* const fz = out[2];
+      const double* const tix = out[3];
+      const double* const tiy = out[4];
+      const double* const tiz = out[5];
+      const double* const tjx = out[6];
+      const double* const tjy = out[7];
+      const double* const tjz = out[8];
+      const double* const ov = out[9];
+      const std::int64_t* const tag = P.tag.data();
+      auto flush = [&]() {
+        const int size = batch.size;
+        for (int h = 0; h < size; h += kLanes)
+          contact_pack<Periodic>(a, step, batch, h, h + 1 < size);
+        // The sums on i stay in registers while its contacts follow one another (partners
+        // have j > i, so no other contact of the batch adds to f[i] meanwhile).
+        for (int h = 0; h < size;) {
+          const int i = bi[h];
+          Vec3 fi = f[i], ti = t[i];
+          const double ri = rad[i];
+          for (; h < size && bi[h] == i; ++h) {
+            const int j = bj[h];
+            touching[bk[h]] = 1;
+            const Vec3 force{fx[h], fy[h], fz[h]};
+            fi += force;
+            f[j] -= force;
+            ti += Vec3{tix[h], tiy[h], tiz[h]};
+            t[j] += Vec3{tjx[h], tjy[h], tjz[h]};
+            const double rmin = std::min(ri, rad[j]);
+            if (ov[h] > my_ratio * rmin) {
+              my_ratio = ov[h] / rmin;
+              my_tag = tag[i];
+            }
+          }
+          f[i] = fi;
+          t[i] = ti;
+        }
+        batch.size = 0;
+      };
 #pragma omp barrier
       for (std::size_t i = own.begin; i < own.end; ++i) {
         const int k_end = first[i + 1];
         if (first[i] == k_end) continue;
+        if (batch.size + (k_end - first[i]) > capacity) flush();
         const Vec3 xi = x[i];
         const double ri = rad[i];
-        // Pass 1 sorts the listed pairs into touching ones, without branching on a
-        // coin-flip condition, and flags contacts that opened. As in LIGGGHTS, the history of
-        // a pair that opened is kept while the pair stays in the list (a contact that closes
-        // again before the next neighbour build resumes it); the build drops it unless the
-        // pair touches at the build's positions (see NeighborList::build).
-        int m = 0;
+        // Pass 1 sorts the listed pairs into touching ones and flags contacts that opened,
+        // without branching on the coin-flip condition. As in LIGGGHTS, the history of a pair
+        // that opened is kept while the pair stays in the list (a contact that closes again
+        // before the next neighbour build resumes it); the build drops it unless the pair
+        // touches at the build's positions (see NeighborList::build).
+        int m = batch.size;
         for (int k = first[i]; k < k_end; ++k) {
           const int j = partner[k];
           Vec3 d = xi - x[j];
           if constexpr (Periodic) d = a.domain.minimum_image(d);
           const double radsum = ri + rad[j];
           const bool apart = norm2(d) >= radsum * radsum;
-          hits[m] = k;
+          bi[m] = static_cast<int>(i);
+          bj[m] = j;
+          bk[m] = k;
           m += !apart;
-          if (apart && touching[k]) touching[k] = 0;
+          touching[k] &= static_cast<std::uint8_t>(!apart);
         }
-        if (m == 0) continue;
-        contacts += m;
-        // Pass 2 sets up the geometry of all contacts of i before pass 3 runs their laws:
-        // the square roots and divisions of different contacts then overlap in the pipeline.
-        const Vec3 vi = v[i], wi = w[i];
-        const double mi = mass[i];
-        for (int h = 0; h < m; ++h) {
-          const int j = partner[hits[h]];
-          Vec3 d = xi - x[j];
-          if constexpr (Periodic) d = a.domain.minimum_image(d);
-          const double r = std::sqrt(norm2(d));
-          const double rj = rad[j];
-          const double radsum = ri + rj;
-          ContactInput& c = inputs[h];
-          c.dist = r;
-          c.n = (1.0 / r) * d;
-          c.overlap = radsum - r;
-          c.ri = ri;
-          c.rj = rj;
-          c.r_eff = ri * rj / radsum;
-          c.m_eff = mi * mass[j] / (mi + mass[j]);
-          if (freeze_bit) {  // rare: branch only then
-            if (mask[i] & freeze_bit) c.m_eff = mass[j];
-            if (mask[j] & freeze_bit) c.m_eff = mi;
-          }
-          c.cri = ri - 0.5 * c.overlap;
-          c.crj = rj - 0.5 * c.overlap;
-          c.v_rel = vi - v[j];
-          c.omega_i = wi;
-          c.omega_j = w[j];
-        }
-        // Pass 3: the contact laws. Partners have j > i, so the sums on i stay in registers.
-        Vec3 fi = f[i], ti = t[i];
-        const int type_i = type[i];
-        for (int h = 0; h < m; ++h) {
-          const int k = hits[h];
-          const int j = partner[k];
-          const ContactInput& c = inputs[h];
-          touching[k] = 1;
-          ContactResult res;
-          contact_law<Cohesion, Rolling>(c, a.material.get(type_i, type[j]), step,
-                                         hist_all + static_cast<std::size_t>(k) * kHistorySize,
-                                         res);
-          fi += res.force;
-          f[j] -= res.force;
-          ti += res.torque_i;
-          t[j] += res.torque_j;
-          const double rmin = std::min(c.ri, c.rj);
-          if (c.overlap > my_ratio * rmin) {
-            my_ratio = c.overlap / rmin;
-            my_tag = P.tag[i];
-          }
-        }
-        f[i] = fi;
-        t[i] = ti;
+        contacts += m - batch.size;
+        batch.size = m;
       }
+      flush();
 #pragma omp critical
       if (my_ratio > worst_ratio) {
         worst_ratio = my_ratio;

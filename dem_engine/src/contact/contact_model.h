@@ -50,6 +50,16 @@ struct PairForceArgs {
   long contacts = 0;               // out: touching pairs
 };
 
+// One contact of particle i with a wall (what Simulation::wall_contact takes).
+struct WallContact {
+  std::size_t i = 0;
+  Vec3 normal;  // unit normal from the wall towards the particle centre
+  double overlap = 0.0, dist = 0.0;
+  Vec3 wall_velocity;
+  int wall_type = 1;           // atom type of the wall material
+  double* history = nullptr;   // kHistorySize doubles
+};
+
 // The contact law chosen at run time; the per-contact code is composed at compile time from
 // one sub-model per file (normal_hertz.h, tangential_history.h, cohesion_*.h, rolling_*.h).
 class ContactModel {
@@ -60,6 +70,11 @@ class ContactModel {
   // One contact: updates history (kHistorySize doubles) and fills result.
   virtual void evaluate(const ContactInput& c, const PairParams& p, const ContactStep& step,
                         double* history, ContactResult& result) const = 0;
+  // Many wall contacts at once: results[k] is what Simulation::wall_contact gives for
+  // contacts[k], bit for bit.
+  virtual void wall_forces(const Particles& atoms, const MaterialTable& material,
+                           const ContactStep& step, const WallContact* contacts, std::size_t count,
+                           ContactResult* results) const = 0;
   // All particle pairs of the neighbour list; sets f and torque of every particle to the sum
   // of its pair forces and torques.
   virtual void pair_forces(PairForceArgs& args) const = 0;

@@ -188,50 +188,98 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   // between builds: their capacity makes later builds allocation-free.
   if (found_.size() < n) found_.resize(n);
   const int nthreads = worker_threads(n);
-#pragma omp parallel num_threads(nthreads)
-  {
-    std::vector<int> stencil;
-    stencil.reserve(27);
-#pragma omp for schedule(dynamic, 16)
+  if (!any_periodic) {
+    // Positions and radii in bin order: the bins x-1, x, x+1 of a row are consecutive bin
+    // indices, so their particles are one contiguous run, and a stencil is 9 runs.
+    bin_x_.resize(n);
+    bin_r_.resize(n);
+    for (std::size_t s = 0; s < n; ++s) {
+      const auto i = static_cast<std::size_t>(bin_items[s]);
+      bin_x_[s] = p.x[i];
+      bin_r_[s] = p.radius[i];
+    }
+    const Vec3* bx = bin_x_.data();
+    const double* br = bin_r_.data();
+    const int* items = bin_items.data();
+    const int* start = bin_start.data();
+#pragma omp parallel for schedule(dynamic, 16) num_threads(nthreads)
     for (std::size_t b = 0; b < nbins; ++b) {
-      if (bin_start[b] == bin_start[b + 1]) continue;
-      const int bx = static_cast<int>(b % nb[0]), by = static_cast<int>((b / nb[0]) % nb[1]);
+      if (start[b] == start[b + 1]) continue;
+      const int bx0 = static_cast<int>(b % nb[0]), by = static_cast<int>((b / nb[0]) % nb[1]);
       const int bz = static_cast<int>(b / (static_cast<std::size_t>(nb[0]) * nb[1]));
-      stencil.clear();
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            int c[3] = {bx + dx, by + dy, bz + dz};
-            bool ok = true;
-            for (int k = 0; k < 3 && ok; ++k) {
-              if (c[k] < 0 || c[k] >= nb[k]) {
-                if (domain.periodic(k)) c[k] = (c[k] + nb[k]) % nb[k];
-                else ok = false;
-              }
-            }
-            if (!ok) continue;
-            const int cb = (c[2] * nb[1] + c[1]) * nb[0] + c[0];
-            if (std::find(stencil.begin(), stencil.end(), cb) == stencil.end())
-              stencil.push_back(cb);
-          }
-      for (int s = bin_start[b]; s < bin_start[b + 1]; ++s) {
-        const int i = bin_items[s];
-        const Vec3 xi = p.x[i];
-        const double ri = p.radius[i] + skin;
-        auto& out = found_[i];
+      // The 9 runs [first bin of the row, one past its last bin), rows in (z, y) order.
+      int runs[9][2];
+      int nruns = 0;
+      const int x_lo = std::max(bx0 - 1, 0), x_hi = std::min(bx0 + 1, nb[0] - 1);
+      for (int z = std::max(bz - 1, 0); z <= std::min(bz + 1, nb[2] - 1); ++z)
+        for (int y = std::max(by - 1, 0); y <= std::min(by + 1, nb[1] - 1); ++y) {
+          const int row = (z * nb[1] + y) * nb[0];
+          runs[nruns][0] = start[row + x_lo];
+          runs[nruns][1] = start[row + x_hi + 1];
+          ++nruns;
+        }
+      for (int s = start[b]; s < start[b + 1]; ++s) {
+        const int i = items[s];
+        const Vec3 xi = bx[s];
+        const double ri = br[s] + skin;
+        auto& out = found_[static_cast<std::size_t>(i)];
         out.clear();
-        for (int cb : stencil) {
-          for (int t = bin_start[cb]; t < bin_start[cb + 1]; ++t) {
-            const int j = bin_items[t];
+        for (int r = 0; r < nruns; ++r)
+          for (int t = runs[r][0]; t < runs[r][1]; ++t) {
+            const int j = items[t];
             if (j <= i) continue;
-            Vec3 d = xi - p.x[j];
-            if (any_periodic) d = domain.minimum_image(d);
-            const double reach = ri + p.radius[j];
+            const Vec3 d = xi - bx[t];
+            const double reach = ri + br[t];
             if (norm2(d) < reach * reach) out.push_back(j);
           }
-        }
         // Sorted partners give a deterministic pair order and allow the merge below.
         std::sort(out.begin(), out.end());
+      }
+    }
+  } else {  // periodic: the stencil wraps, and bins may repeat when a dimension is short
+#pragma omp parallel num_threads(nthreads)
+    {
+      std::vector<int> stencil;
+      stencil.reserve(27);
+#pragma omp for schedule(dynamic, 16)
+      for (std::size_t b = 0; b < nbins; ++b) {
+        if (bin_start[b] == bin_start[b + 1]) continue;
+        const int bx = static_cast<int>(b % nb[0]), by = static_cast<int>((b / nb[0]) % nb[1]);
+        const int bz = static_cast<int>(b / (static_cast<std::size_t>(nb[0]) * nb[1]));
+        stencil.clear();
+        for (int dz = -1; dz <= 1; ++dz)
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+              int c[3] = {bx + dx, by + dy, bz + dz};
+              bool ok = true;
+              for (int k = 0; k < 3 && ok; ++k) {
+                if (c[k] < 0 || c[k] >= nb[k]) {
+                  if (domain.periodic(k)) c[k] = (c[k] + nb[k]) % nb[k];
+                  else ok = false;
+                }
+              }
+              if (!ok) continue;
+              const int cb = (c[2] * nb[1] + c[1]) * nb[0] + c[0];
+              if (std::find(stencil.begin(), stencil.end(), cb) == stencil.end())
+                stencil.push_back(cb);
+            }
+        for (int s = bin_start[b]; s < bin_start[b + 1]; ++s) {
+          const int i = bin_items[s];
+          const Vec3 xi = p.x[i];
+          const double ri = p.radius[i] + skin;
+          auto& out = found_[i];
+          out.clear();
+          for (int cb : stencil) {
+            for (int t = bin_start[cb]; t < bin_start[cb + 1]; ++t) {
+              const int j = bin_items[t];
+              if (j <= i) continue;
+              const Vec3 d = domain.minimum_image(xi - p.x[j]);
+              const double reach = ri + p.radius[j];
+              if (norm2(d) < reach * reach) out.push_back(j);
+            }
+          }
+          std::sort(out.begin(), out.end());
+        }
       }
     }
   }

@@ -60,6 +60,8 @@ class NeighborList {
   std::vector<std::int64_t> tags_at_build_;
   ParticlePartition partition_;
   std::vector<std::vector<int>> found_;  // partners per particle, reused between builds
+  std::vector<Vec3> bin_x_;              // positions in bin order (build scratch)
+  std::vector<double> bin_r_;            // radii in bin order (build scratch)
   bool forced_ = true;
   long builds_ = 0;
   int max_pairs_ = 0;

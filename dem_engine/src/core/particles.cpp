@@ -11,6 +11,7 @@ double sphere_mass(double radius, double density) {
 
 std::size_t Particles::add(std::int64_t id, int atom_type, std::uint32_t group_mask,
                            const Vec3& position, double particle_radius, double particle_density) {
+  ++mass_version_;
   tag.push_back(id);
   type.push_back(atom_type);
   mask.push_back(group_mask);
@@ -43,6 +44,7 @@ void compact(std::vector<T>& values, const std::vector<char>& flagged, std::size
 }  // namespace
 
 void Particles::remove(const std::vector<char>& flagged) {
+  ++mass_version_;
   compact(tag, flagged);
   compact(type, flagged);
   compact(mask, flagged);
@@ -68,6 +70,7 @@ void reorder(std::vector<T>& values, const std::vector<std::size_t>& order, std:
 }  // namespace
 
 void Particles::permute(const std::vector<std::size_t>& order) {
+  ++mass_version_;
   reorder(tag, order);
   reorder(type, order);
   reorder(mask, order);
@@ -83,11 +86,13 @@ void Particles::permute(const std::vector<std::size_t>& order) {
 }
 
 void Particles::set_radius(std::size_t i, double r) {
+  ++mass_version_;
   radius[i] = r;
   rmass[i] = sphere_mass(r, density[i]);
 }
 
 void Particles::set_density(std::size_t i, double rho) {
+  ++mass_version_;
   density[i] = rho;
   rmass[i] = sphere_mass(radius[i], rho);
 }

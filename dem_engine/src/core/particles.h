@@ -38,6 +38,9 @@ class Particles {
   std::int64_t max_tag() const noexcept { return max_tag_; }
   // Local index of a tag, or -1.
   long index_of(std::int64_t id) const;
+  // Changes whenever a particle is added, removed or reordered, or its radius or mass changes:
+  // per-particle values derived from them can be cached until it does.
+  std::uint64_t mass_version() const noexcept { return mass_version_; }
 
   // Per-particle extra storage of `width` doubles per particle, initialised to zero.
   std::size_t register_extra(const std::string& name, std::size_t width);
@@ -52,6 +55,7 @@ class Particles {
   };
   std::vector<Extra> extras_;
   std::int64_t max_tag_ = 0;
+  std::uint64_t mass_version_ = 0;
 };
 
 double sphere_mass(double radius, double density);

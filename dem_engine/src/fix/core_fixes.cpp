@@ -82,29 +82,38 @@ class FixNveSphere : public Fix {
     auto& P = sim_.atoms;
     const double dt = sim_.dt, half = 0.5 * dt;
     const std::uint32_t bit = group_bit();
-    const double* mass = P.rmass.data();
-    const double* rad = P.radius.data();
+    update_inverses();
+    const double* inv_m = inv_m_.data();
+    const double* inv_i = inv_i_.data();
     sim_.neighbor.partition().for_each(P.size(), [&](std::size_t begin, std::size_t end) {
-      // Blocks of particles: the inverse masses and inertias of a block are computed in a
-      // loop of their own, which the compiler vectorises (the divisions dominate otherwise).
-      constexpr std::size_t kBlock = 64;
-      double inv_m[kBlock], inv_i[kBlock];
-      for (std::size_t lo = begin; lo < end; lo += kBlock) {
-        const std::size_t m = std::min(kBlock, end - lo);
-        for (std::size_t k = 0; k < m; ++k) {
-          inv_m[k] = 1.0 / mass[lo + k];
-          inv_i[k] = 1.0 / sphere_inertia(mass[lo + k], rad[lo + k]);
-        }
-        for (std::size_t k = 0; k < m; ++k) {
-          const std::size_t i = lo + k;
-          if (!(P.mask[i] & bit)) continue;
-          P.v[i] += (half * inv_m[k]) * P.f[i];
-          P.omega[i] += (half * inv_i[k]) * P.torque[i];
-          if (drift) P.x[i] += dt * P.v[i];
-        }
+      for (std::size_t i = begin; i < end; ++i) {
+        if (!(P.mask[i] & bit)) continue;
+        P.v[i] += (half * inv_m[i]) * P.f[i];
+        P.omega[i] += (half * inv_i[i]) * P.torque[i];
+        if (drift) P.x[i] += dt * P.v[i];
       }
     });
   }
+
+  // Inverse masses and inertias, recomputed only when particles or their masses change, not
+  // four divisions per particle and step (the same values: 1 / m is computed the same way).
+  void update_inverses() {
+    const auto& P = sim_.atoms;
+    if (inverses_of_ == P.mass_version() && inv_m_.size() == P.size()) return;
+    const std::size_t n = P.size();
+    inv_m_.resize(n);
+    inv_i_.resize(n);
+    const double* mass = P.rmass.data();
+    const double* rad = P.radius.data();
+    for (std::size_t i = 0; i < n; ++i) {
+      inv_m_[i] = 1.0 / mass[i];
+      inv_i_[i] = 1.0 / sphere_inertia(mass[i], rad[i]);
+    }
+    inverses_of_ = P.mass_version();
+  }
+
+  std::vector<double> inv_m_, inv_i_;
+  std::uint64_t inverses_of_ = ~std::uint64_t{0};
 };
 
 // fix ID group freeze: zero force and torque on the group (LAMMPS semantics).

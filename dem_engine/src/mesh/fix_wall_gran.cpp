@@ -37,6 +37,8 @@ std::string describe(const ModelSpec& s) {
 constexpr double kMaxOverlapRatio = 0.5;
 // Contacts of one particle that are evaluated (beyond any plausible packing).
 constexpr std::size_t kMaxContacts = 64;
+// Primitive-wall contacts whose laws are run together.
+constexpr std::size_t kWallChunk = 64;
 // Below this many particles a parallel region costs more than it saves.
 constexpr std::size_t kParallelMin = 4096;
 
@@ -182,6 +184,11 @@ void FixWallGran::primitive_forces() {
   double* hist_all = P.extra(history_).data();
   double worst = 0.0;
   long worst_tag = -1;
+  const ContactModel& model = sim_.pair_model();
+  ContactStep step;  // as Simulation::wall_contact sets it
+  step.options = model.spec().options;
+  step.dt = sim_.dt;
+  step.update_history = !sim_.setting_up();
 #pragma omp parallel num_threads(worker_threads(n)) if (n >= kParallelMin)
   {
     double my_worst = 0.0;
@@ -191,6 +198,26 @@ void FixWallGran::primitive_forces() {
         sim_.neighbor.partition().share(n, omp_get_thread_num(), omp_get_num_threads());
     const auto from = std::lower_bound(near_.begin(), near_.end(), own.begin);
     const auto to = std::lower_bound(from, near_.end(), own.end);
+    // Contacts are collected in chunks and their laws run together (ContactModel::wall_forces,
+    // two at a time); each particle has one contact with this wall, so the order in which the
+    // forces are added changes no sum.
+    WallContact chunk[kWallChunk];
+    ContactResult results[kWallChunk];
+    std::size_t count = 0;
+    auto flush = [&]() {
+      model.wall_forces(P, sim_.material, step, chunk, count, results);
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::size_t i = chunk[k].i;
+        P.f[i] += results[k].force;
+        P.torque[i] += results[k].torque_i;
+        const double overlap = chunk[k].overlap;
+        if (overlap > my_worst * P.radius[i]) {
+          my_worst = overlap / P.radius[i];
+          my_tag = static_cast<long>(P.tag[i]);
+        }
+      }
+      count = 0;
+    };
     for (auto it = from; it != to; ++it) {
       const std::size_t i = *it;
       double* hist = hist_all + i * kHistorySize;
@@ -200,16 +227,17 @@ void FixWallGran::primitive_forces() {
         std::fill(hist, hist + kHistorySize, 0.0);
         continue;
       }
-      const double overlap = P.radius[i] - dist;
-      ContactResult res;
-      sim_.wall_contact(i, normal, overlap, dist, Vec3{}, wall_type_, hist, res);
-      P.f[i] += res.force;
-      P.torque[i] += res.torque_i;
-      if (overlap > my_worst * P.radius[i]) {
-        my_worst = overlap / P.radius[i];
-        my_tag = static_cast<long>(P.tag[i]);
-      }
+      WallContact& c = chunk[count++];
+      c.i = i;
+      c.normal = normal;
+      c.overlap = P.radius[i] - dist;
+      c.dist = dist;
+      c.wall_velocity = Vec3{};
+      c.wall_type = wall_type_;
+      c.history = hist;
+      if (count == kWallChunk) flush();
     }
+    flush();
 #pragma omp critical
     if (my_worst > worst || (my_worst == worst && my_tag >= 0 && my_tag < worst_tag)) {
       worst = my_worst;
