@@ -140,6 +140,34 @@ def write_dataset(
         One row per failed case (kept in the dataset, excluded from training).
     """
     data = collect(pd.read_csv(path) for path in bulk_files)
+    return data, write_collected(data, dataset, failed, config)
+
+
+def write_collected(
+    data: pd.DataFrame,
+    dataset: str | Path,
+    failed: str | Path,
+    config: Mapping[str, Any],
+    extra: Mapping[str, Any] | None = None,
+) -> pd.DataFrame:
+    """Write a collected dataset, its list of failed cases and its provenance sidecar.
+
+    Parameters
+    ----------
+    data : DataFrame
+        The tidy dataset (:func:`collect`).
+    dataset, failed : path
+        Outputs, as in :func:`write_dataset`.
+    config : mapping
+        The validated configuration (for the sidecar).
+    extra : mapping, optional
+        More sidecar fields (e.g. the round of a sequential study).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per failed case.
+    """
     data.to_csv(dataset, index=False, float_format="%.10g")
     bad = data[data["status"] != "ok"].drop_duplicates("case_id")
     bad[["test", "case_id", "error"]].to_csv(failed, index=False)
@@ -150,6 +178,7 @@ def write_dataset(
             "rows": len(data),
             "cases": int(data["case_id"].nunique()),
             "failed_cases": len(bad),
+            **(extra or {}),
         },
     )
-    return data, bad
+    return bad

@@ -61,9 +61,7 @@ def rounds_figure(
         r2_ax.plot(rounds, table[column], ".-", label=column.removesuffix("_test_r2"))
     r2_ax.set_xlabel("round")
     r2_ax.set_ylabel("network test R$^2$")
-    r2_ax.set_ylim(
-        min(0.0, float(np.nanmin(table.filter(like="_test_r2").to_numpy(), initial=0))), 1.05
-    )
+    r2_ax.set_ylim(float(np.nanmin(table.filter(like="_test_r2").to_numpy(), initial=0.0)), 1.05)
     r2_ax.legend(fontsize=8)
     for ax in axes[1][2:]:
         ax.axis("off")

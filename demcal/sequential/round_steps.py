@@ -11,6 +11,7 @@ from typing import Any
 
 import pandas as pd
 
+from demcal.bulk.dataset import write_collected
 from demcal.core.experiments import load_experiment
 from demcal.core.provenance import write_sidecar
 from demcal.design.table import design_frame, write_design_table
@@ -25,6 +26,7 @@ from demcal.sequential.proposal import (
     propose,
 )
 from demcal.sequential.rounds import (
+    design_ranges,
     round_bases,
     round_dataset,
     round_record,
@@ -43,11 +45,6 @@ def take_over(source: str | Path, target: str | Path) -> Path:
         if item.is_file():
             shutil.copyfile(item, dst / item.name)
     return src
-
-
-def design_ranges(config: Mapping[str, Any]) -> dict[str, list[float]]:
-    """The design box: parameter -> [low, high] (``design.ranges``)."""
-    return {k: [float(v[0]), float(v[1])] for k, v in config["design"]["ranges"].items()}
 
 
 def _valid_sets(identified_file: str | Path) -> pd.DataFrame:
@@ -72,10 +69,7 @@ def write_round_dataset(
     See :func:`demcal.sequential.rounds.round_dataset` for the parameters.
     """
     data = round_dataset(new_bulk, previous, verification_bulk, round_no - 1)
-    data.to_csv(dataset, index=False, float_format="%.10g")
-    bad = data[data["status"] != "ok"].drop_duplicates("case_id")
-    bad[["test", "case_id", "error"]].to_csv(failed, index=False)
-    write_sidecar(dataset, dict(config), extra={"round": round_no, "rows": len(data)})
+    write_collected(data, dataset, failed, dict(config), extra={"round": round_no})
     return data
 
 

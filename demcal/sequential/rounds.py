@@ -58,6 +58,11 @@ def check_sequential(config: Mapping[str, Any]) -> None:
         )
 
 
+def design_ranges(config: Mapping[str, Any]) -> dict[str, list[float]]:
+    """The design box: parameter -> [low, high] (``design.ranges``)."""
+    return {k: [float(v[0]), float(v[1])] for k, v in config["design"]["ranges"].items()}
+
+
 def round_of_case(config: Mapping[str, Any], base: str) -> int:
     """The round that runs design set ``base`` (``c0001`` ...)."""
     number = int(base.lstrip("c"))
@@ -193,7 +198,7 @@ def round_record(
         measured, deviation), ``verified``, ``surrogates``, ``stop`` and ``reason``.
     """
     seq = config["sequential"]
-    ranges = {k: [float(v[0]), float(v[1])] for k, v in config["design"]["ranges"].items()}
+    ranges = design_ranges(config)
     sets = len(round_bases(config, round_no))
     runs = sets * runs_per_set(config)
     checked: dict[str, dict[str, float]] = {}

@@ -111,10 +111,13 @@ def round_verification_bulk(round_no):
     identified = checkpoints.sequential_identify.get(round=round_no).output.identified
     if not json.loads(Path(identified).read_text()).get("parameters"):
         return []
+    return verification_bulk_under(round_path(round_no, "verification"))
+
+
+def verification_bulk_under(directory):
+    """bulk.csv of every verification case (each replicate, each load) below ``directory``."""
     return [
-        round_path(round_no, f"verification/{test}/{case}/bulk.csv")
-        for test in TESTS
-        for case in VERIFICATION_CASES[test]
+        f"{directory}/{test}/{case}/bulk.csv" for test in TESTS for case in VERIFICATION_CASES[test]
     ]
 
 
@@ -134,11 +137,7 @@ def verification_bulk_files(engine):
     those runs are reused."""
     if SEQUENTIAL and engine == CONFIGURED_ENGINE:
         return round_verification_bulk(last_round())
-    return [
-        f"{RESULTS}/verification/{engine}/{test}/{case}/bulk.csv"
-        for test in TESTS
-        for case in VERIFICATION_CASES[test]
-    ]
+    return verification_bulk_under(f"{RESULTS}/verification/{engine}")
 
 
 def verified_set(wildcards):
