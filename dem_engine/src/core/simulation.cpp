@@ -103,11 +103,15 @@ void Simulation::wall_contact(std::size_t i, const Vec3& normal, double overlap,
   c.v_rel = atoms.v[i] - wall_velocity;
   c.omega_i = atoms.omega[i];
   c.omega_j = Vec3{};
+  pair_model().evaluate(c, material.get(atoms.type[i], wall_type), wall_step(), history, result);
+}
+
+ContactStep Simulation::wall_step() const {
   ContactStep step;
   step.options = pair_model().spec().options;
   step.dt = dt;
   step.update_history = !setting_up_;
-  pair_model().evaluate(c, material.get(atoms.type[i], wall_type), step, history, result);
+  return step;
 }
 
 double Simulation::kinetic_energy(std::uint32_t bit) const {

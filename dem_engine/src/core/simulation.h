@@ -81,6 +81,9 @@ class Simulation : public CommandHandler, public EvalContext {
   void wall_contact(std::size_t i, const Vec3& normal, double overlap, double dist,
                     const Vec3& wall_velocity, int wall_type, double* history,
                     ContactResult& result) const;
+  // The step settings of a wall contact: the pair model's options, dt, and whether the
+  // history advances (not while a run computes its initial forces).
+  ContactStep wall_step() const;
   const ContactModel& pair_model() const;  // throws if no pair_style
   // True while a run computes its initial forces: contact histories are used, not advanced.
   bool setting_up() const { return setting_up_; }

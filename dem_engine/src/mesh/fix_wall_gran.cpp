@@ -185,10 +185,7 @@ void FixWallGran::primitive_forces() {
   double worst = 0.0;
   long worst_tag = -1;
   const ContactModel& model = sim_.pair_model();
-  ContactStep step;  // as Simulation::wall_contact sets it
-  step.options = model.spec().options;
-  step.dt = sim_.dt;
-  step.update_history = !sim_.setting_up();
+  const ContactStep step = sim_.wall_step();
 #pragma omp parallel num_threads(worker_threads(n)) if (n >= kParallelMin)
   {
     double my_worst = 0.0;
