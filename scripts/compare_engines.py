@@ -78,7 +78,7 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "--sets",
         nargs="+",
         default=["low", "middle", "cohesion"],
-        help="parameter sets (low, middle, high, cohesion)",
+        help="parameter sets (low, middle, high, interlocking, cohesion)",
     )
     parser.add_argument(
         "--engines",

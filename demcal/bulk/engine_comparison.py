@@ -63,8 +63,8 @@ _BASE_SET: dict[str, float] = {
 }
 
 #: Cohesion energy density (J/m^3) of the cohesive set per profile: large enough to change the
-#: bulk values of the profile's cells; on tiny's soft particles 50 kJ/m^3 already drove a shear
-#: run into the engine's 50 % overlap guard.
+#: bulk values of the profile's cells; on tiny's soft particles 50 kJ/m^3 already makes the
+#: heap stand as a column.
 _COHESION: dict[str, float] = {"tiny": 20000.0, "quick": 100000.0}
 
 
@@ -81,7 +81,8 @@ def parameter_sets(profile: str = "tiny") -> dict[str, dict[str, float]]:
     -------
     dict
         ``low`` (mu_s 0.3, mu_r 0.1), ``middle`` (mu_s 0.6, mu_r 0.3), ``high`` (mu_s 0.9,
-        mu_r 0.1, otherwise as ``low``) and ``cohesion`` (mu_s 0.5, mu_r 0.2 and
+        mu_r 0.1, otherwise as ``low``), ``interlocking`` (mu_s 0.9, mu_r 0.7: particles pinch
+        at the rim of the split shear cell) and ``cohesion`` (mu_s 0.5, mu_r 0.2 and
         cohesionEnergyDensity > 0); COR 0.6 and rho_p 2500 kg/m^3 throughout.
     """
     cohesion = _COHESION.get(profile, _COHESION["quick"])
@@ -93,6 +94,11 @@ def parameter_sets(profile: str = "tiny") -> dict[str, dict[str, float]]:
             "coefficientRollingFriction": 0.3,
         },
         "high": {**_BASE_SET, "coefficientFriction": 0.9},
+        "interlocking": {
+            **_BASE_SET,
+            "coefficientFriction": 0.9,
+            "coefficientRollingFriction": 0.7,
+        },
         "cohesion": {
             **_BASE_SET,
             "coefficientFriction": 0.5,

@@ -9,6 +9,9 @@ import sys
 import time
 from pathlib import Path
 
+#: Warning lines kept in a run's ``status.json``.
+MAX_WARNINGS = 20
+
 
 def engine_command(template: str, deck: str, threads: int) -> list[str]:
     """The command line for one deck, from the ``engine.command`` template.
@@ -51,14 +54,29 @@ def error_lines(case_dir: Path) -> list[str]:
     output and its log file (``ERROR: ...`` or, under MPI, ``ERROR on proc N: ...``), so all three
     files are read and a line seen twice is kept once.
     """
+    return marked_lines(case_dir, "ERROR")
+
+
+def warning_lines(case_dir: Path) -> list[str]:
+    """The non-empty ``WARNING`` lines of a finished run (as :func:`error_lines`).
+
+    The bundled engine warns, for example, when a contact overlaps by more than half a radius (a
+    particle pinched between walls) and carries on, as LIGGGHTS does.
+    """
+    return [line for line in marked_lines(case_dir, "WARNING") if line.rstrip(": ") != "WARNING"]
+
+
+def marked_lines(case_dir: Path, marker: str) -> list[str]:
+    """Lines starting with ``marker`` in the run's screen output and log, each once, in order."""
     seen: dict[str, None] = {}
     for name in ("engine.err", "engine.out", "log.liggghts"):
         path = case_dir / name
         if not path.is_file():
             continue
-        for line in path.read_text(errors="replace").splitlines():
-            if line.startswith("ERROR"):
-                seen.setdefault(line.strip(), None)
+        with path.open(errors="replace") as f:
+            for line in f:
+                if line.startswith(marker):
+                    seen.setdefault(line.strip(), None)
     return list(seen)
 
 
@@ -73,7 +91,8 @@ def run_deck(case_dir: str | Path, deck: str, template: str, threads: int) -> di
     Returns
     -------
     dict
-        The status record: status, returncode, seconds, command, error.
+        The status record: status, returncode, seconds, command, threads, error and warnings
+        (the first :data:`MAX_WARNINGS` warning lines).
     """
     case_dir = Path(case_dir)
     cmd = engine_command(template, deck, threads)
@@ -91,6 +110,7 @@ def run_deck(case_dir: str | Path, deck: str, template: str, threads: int) -> di
         "command": cmd,
         "threads": threads,
         "error": errors[-1] if errors else ("" if returncode == 0 else f"exit code {returncode}"),
+        "warnings": warning_lines(case_dir)[:MAX_WARNINGS],
     }
     (case_dir / "status.json").write_text(json.dumps(status, indent=2) + "\n")
     return status

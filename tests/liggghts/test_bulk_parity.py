@@ -13,9 +13,8 @@ is significant. That the test can fail is shown on the same runs: sliding fricti
 0.9 on one engine, and LIGGGHTS at mu_s 0.3 against the engine at mu_s 0.9, must be flagged
 (the bulk density, about 100 kg/m^3 apart with a seed scatter of about 10 kg/m^3, is).
 
-At 50 kJ/m^3 a tiny cohesive shear run stopped on the engine's overlap guard (a particle 50 %
-of its radius into a neighbour) where LIGGGHTS, which has no such guard, carried on, and the
-heaps stood as columns (aor about 100 deg); 20 kJ/m^3 runs on both, with heaps of 38-59 deg.
+At 50 kJ/m^3 the tiny cohesive heaps stood as columns (aor about 100 deg) on both engines;
+20 kJ/m^3 gives heaps of 38-59 deg.
 
 About 4 minutes on two otherwise idle cores (48 runs); more when the cores are shared.
 """

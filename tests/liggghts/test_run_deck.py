@@ -13,6 +13,8 @@ import pytest
 
 from demcal.engine_io.run import run_deck
 
+from .test_contact_parity import CASES, write_case
+
 pytestmark = pytest.mark.liggghts
 
 BAD_DECK = """atom_style granular
@@ -41,3 +43,24 @@ def test_a_failed_run_records_the_engines_error_line(tmp_path: Path, engine: str
     assert status["error"].startswith("ERROR"), status["error"]
     assert "no_such_command" in status["error"].lower() or "unknown" in status["error"].lower()
     assert json.loads((tmp_path / "status.json").read_text()) == status
+
+
+@pytest.mark.parametrize("engine", sorted(ENGINES))
+def test_a_pinched_particle_finishes_and_its_warning_is_recorded(
+    tmp_path: Path, engine: str
+) -> None:
+    # Two particles squeezed by a plate until their contacts overlap by more than half a
+    # radius: LIGGGHTS carries on, and so does the bundled engine, with a warning kept in the
+    # status record.
+    case = CASES["pinched_stack"]
+    write_case(tmp_path, case.deck, case.files)
+    status = run_deck(tmp_path, "in.deck", ENGINES[engine], 1)
+    assert status["status"] == "ok", status["error"]
+    assert json.loads((tmp_path / "status.json").read_text()) == status
+    assert all(w.startswith("WARNING") and w.rstrip(": ") != "WARNING" for w in status["warnings"])
+    pinched = [w for w in status["warnings"] if "overlaps a neighbour by" in w]
+    if engine == "bundled":
+        assert pinched and "the run goes on" in pinched[0], status["warnings"]
+        assert any("steps of this run had a contact overlapping" in w for w in status["warnings"])
+    else:
+        assert not pinched, status["warnings"]

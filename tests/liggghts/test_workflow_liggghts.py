@@ -50,8 +50,7 @@ OVERLAY = {
     "engine": {"command": "liggghts -in {deck}", "threads": 1},
     "verification": {"engines": ENGINES, "threads": 2},
     "design": {"kind": "lhs", "n": N_SETS, "seed": 3},
-    # The shear cell keeps tiny's 10 particle diameters: in a cell of 8, the bundled engine
-    # stopped on an unstable contact at a strongly interlocking identified set.
+    # The shear cell keeps tiny's 10 particle diameters.
     "shear_cell": {"P": [0.5, 1.0], "separate_runs": False},
     "angle_of_repose": {"dCylDp": 8, "lift_time": 0.6},
     "surrogate": {"hidden_sizes": [4, 6], "max_epochs": 200, "patience": 20},
@@ -148,23 +147,15 @@ def test_identification_outputs(study):
 
 def test_verification_on_two_engines(study):
     results = study / "results"
-    # Each engine ran the identified set in its own directory, LIGGGHTS on two MPI ranks.
-    # The bundled engine stops a run whose contacts overlap by half a radius, which LIGGGHTS
-    # carries on with; an interlocking identified set can jam the tiny cell's rim (see
-    # docs/virtual-tests.md, known limits). Such a run must be reported, not hidden.
-    report = (results / "verification" / "verification.md").read_text()
-    failed: set[tuple[str, str]] = set()
+    # Each engine ran the identified set in its own directory, LIGGGHTS on two MPI ranks, and
+    # both finish: the bundled engine, like LIGGGHTS, carries on through a contact pinched at
+    # the rim of the split (it only warns, see docs/virtual-tests.md, known limits).
     for engine, program in (("liggghts", "mpirun"), ("bundled", "dem_engine")):
         runs = sorted((results / "verification" / engine).glob("*/*/status.json"))
         assert len(runs) == 2, engine  # one shear run (both P), one angle of repose
         for path in runs:
             status = _status(path.parent)
-            test = path.parent.parent.name
-            if status["status"] != "ok":
-                assert engine == "bundled" and test == "shear_cell", (path, status["error"])
-                assert "overlaps a neighbour by 5" in status["error"], status["error"]
-                assert f"FAILED on {engine}: {test} {path.parent.name}" in report
-                failed.add((engine, test))
+            assert status["status"] == "ok", (path, status["error"])
             assert Path(status["command"][0]).name == program, status["command"]
             assert status["threads"] == 2
     for path in (results / "verification" / "liggghts").glob("*/*/status.json"):
@@ -179,10 +170,6 @@ def test_verification_on_two_engines(study):
     assert list(table["observable"]) == ["mu_psh", "rho_b", "aor"]
     for engine in ("liggghts", "bundled"):
         dem = table[f"dem_{engine}"]
-        shear = table["observable"] != "aor"
-        if (engine, "shear_cell") in failed:
-            assert dem[shear].isna().all() and np.isfinite(dem[~shear]).all(), engine
-            continue
         assert np.isfinite(dem).all(), engine
         deviation = (1.0 - dem / table["measured"]).abs()
         np.testing.assert_allclose(table[f"deviation_{engine}"], deviation)

@@ -80,16 +80,21 @@ void Simulation::compute_forces() {
     PairForceArgs args{atoms,        neighbor,   material,      domain,        dt,
                        !setting_up_, freeze_bit, thread_force_, thread_torque_};
     pair->pair_forces(args);
-    // Blow-up guard: an overlap of half the smaller radius is never physical here.
-    if (args.max_overlap_ratio > 0.5) {
-      std::ostringstream os;
-      os << "unstable simulation at step " << step << ": particle " << args.max_overlap_tag
-         << " overlaps a neighbour by " << format_g(100.0 * args.max_overlap_ratio, 3)
-         << " % of its radius (time step too large or particles too soft)";
-      throw EngineError(os.str());
-    }
+    if (args.max_overlap_ratio > DeepOverlaps::kRatio)
+      note_deep_overlap(args.max_overlap_ratio, args.max_overlap_tag, "a neighbour");
   }
   for (auto& f : fixes) f->post_force();
+}
+
+void Simulation::note_deep_overlap(double ratio, long tag, const std::string& partner) {
+  // A run's initial force evaluation repeats the previous run's last step.
+  if (setting_up_ || !deep_overlaps_.record(step, ratio, tag, partner)) return;
+  std::ostringstream os;
+  os << "step " << step << ": particle " << tag << " overlaps " << partner << " by "
+     << format_g(100.0 * ratio, 3)
+     << " % of its radius (pinched between walls, or a time step too large for the stiffness); "
+        "the run goes on, as in LIGGGHTS";
+  warning(os.str());
 }
 
 void Simulation::check_health() const {
@@ -292,6 +297,16 @@ void Simulation::run(const Command& command) {
     }
     progress.finish();
     for (auto& f : fixes) f->post_run();
+    if (deep_overlaps_.steps() > 0) {
+      std::ostringstream os;
+      os << deep_overlaps_.steps() << " of " << this_run
+         << " steps of this run had a contact overlapping by more than "
+         << format_g(100.0 * DeepOverlaps::kRatio, 3) << " % of a radius, from step "
+         << deep_overlaps_.first_step() << "; deepest " << format_g(100.0 * deep_overlaps_.worst(), 3)
+         << " %, particle " << deep_overlaps_.tag() << " against " << deep_overlaps_.partner();
+      warning(os.str());
+      deep_overlaps_.clear();
+    }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::ostringstream os;
     os << "Loop time of " << format_g(secs, 6) << " on " << omp_get_max_threads()

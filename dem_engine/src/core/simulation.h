@@ -12,6 +12,7 @@
 #include "contact/contact_model.h"
 #include "contact/material.h"
 #include "core/compute.h"
+#include "core/deep_overlaps.h"
 #include "core/domain.h"
 #include "core/groups.h"
 #include "core/neighbor.h"
@@ -74,6 +75,10 @@ class Simulation : public CommandHandler, public EvalContext {
   // Writes to the screen and the log file.
   void message(const std::string& text) override;
   void warning(const std::string& text);
+  // A force evaluation with an overlap deeper than DeepOverlaps::kRatio of the smaller radius
+  // (`partner`: "a neighbour" or "wall ID"): warned at its first occurrence in a run and
+  // summed up at the run's end; the run goes on, as in LIGGGHTS.
+  void note_deep_overlap(double ratio, long tag, const std::string& partner);
   std::ofstream* log_stream() { return log_.is_open() ? &log_ : nullptr; }
   Input& input() { return *input_; }
   // Evaluates a contact between particle i and a wall/mesh surface (walls reuse the pair model).
@@ -128,6 +133,7 @@ class Simulation : public CommandHandler, public EvalContext {
   bool has_run_ = false;
   bool changed_since_run_ = false;
   std::vector<const Fix*> fixes_at_run_;
+  DeepOverlaps deep_overlaps_;
 };
 
 }  // namespace dem

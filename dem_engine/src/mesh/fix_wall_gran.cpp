@@ -32,9 +32,6 @@ std::string describe(const ModelSpec& s) {
   return text;
 }
 
-// Largest overlap (fraction of the radius) a wall contact may reach before the run is declared
-// unstable, as for particle pairs.
-constexpr double kMaxOverlapRatio = 0.5;
 // Contacts of one particle that are evaluated (beyond any plausible packing).
 constexpr std::size_t kMaxContacts = 64;
 // Primitive-wall contacts whose laws are run together.
@@ -330,14 +327,8 @@ void FixWallGran::mesh_forces() {
 }
 
 void FixWallGran::finish_step(double worst_ratio, long worst_tag, long overflow) {
-  if (worst_ratio > kMaxOverlapRatio) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.3g", 100.0 * worst_ratio);
-    throw EngineError("unstable simulation at step " + std::to_string(sim_.step) + ": particle " +
-                      std::to_string(worst_tag) + " overlaps wall " + id() + " by " + buf +
-                      " % of its radius (time step too large, particles too soft or wall too "
-                      "fast)");
-  }
+  if (worst_ratio > DeepOverlaps::kRatio)
+    sim_.note_deep_overlap(worst_ratio, worst_tag, "wall " + id());
   if (overflow > 0 && !overflow_warned_) {
     overflow_warned_ = true;
     sim_.warning("fix " + id() + ": a particle touches more than " + std::to_string(kMeshSlots) +
