@@ -1,11 +1,12 @@
-"""Synthetic measurements with a hidden effect, for testing the discrepancy workflow.
+"""Synthetic measurements with a hidden effect, for validating the discrepancy workflow.
 
-A *truth* file (``config/experiments/truth/hidden_*.yaml``) gives the true parameters, the
-effect switched on in the engine (``switch``, configuration overrides) and the name of that
-effect. The engine runs the virtual tests with it; noise is added; the resulting experiment
-file holds only the noisy bulk values. The model under calibration lacks the effect; the truth
-file is never read by the workflow, only by the study set-up and the tests that check the
-named effect.
+A truth specification (``config/experiments/truth/hidden_*.yaml``) names the hidden effect and
+how the true values are drawn (:mod:`demcal.discrepancy.truths`). The virtual tests run at the
+drawn truth with the effect switched on, by default on LIGGGHTS 3.8 rather than the bundled
+engine, so that the differences between the two codes are part of what the workflow must see
+through; the model under calibration stays on the configured engine. Replicate runs from fresh
+packings are averaged and noise is added per observable; the experiment file holds only the
+noisy values, and the drawn truth is written beside the study, never into its configuration.
 
 The hidden-effect study model is the profile's configuration with the overrides of
 :func:`study_overrides`: one particle size, no rolling resistance, no cohesion, and a design
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 import copy
 import math
+import shutil
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -30,8 +32,11 @@ from demcal.bulk.synthetic import run_case_bulk
 from demcal.core.config import validate_config
 from demcal.design.cases import load_condition, shear_suffixes
 from demcal.discrepancy.candidates import deep_merge
+from demcal.discrepancy.truths import DrawnTruth, draw_truth, load_truth_spec, truth_config
 
 __all__ = [
+    "NOISE",
+    "default_truth_engine",
     "hidden_effect_bulk",
     "prepare_study",
     "replicate_record",
@@ -39,6 +44,10 @@ __all__ = [
     "study_overrides",
     "write_hidden_effect_experiment",
 ]
+
+#: Relative measurement noise added per observable: repeated shear tests scatter by a few per
+#: cent in friction, much less in bulk density.
+NOISE: dict[str, float] = {"mu_psh": 0.03, "mu_sh": 0.03, "rho_b": 0.01, "aor": 0.03}
 
 _MODEL = {
     "particles": {"distribution": "monodisperse"},
@@ -107,21 +116,42 @@ def study_config(raw: Mapping[str, Any], profile: str | None = None) -> dict[str
     return out
 
 
+def default_truth_engine() -> str | None:
+    """``liggghts -in {deck}`` when LIGGGHTS is installed, else None (the study's engine)."""
+    return "liggghts -in {deck}" if shutil.which("liggghts") else None
+
+
 def prepare_study(
     profile_config: str | Path,
     truth_path: str | Path,
     study_dir: str | Path,
-    noise: float = 0.005,
+    noise: Mapping[str, float] | None = None,
     seed: int = 1,
     engine_command: str | None = None,
     workers: int = 2,
     replicates: int = 3,
+    truth_seed: int = 1,
+    truth_engine: str | None = None,
 ) -> Path:
     """Set up a hidden-effect study directory ready for ``snakemake discrepancy``.
 
-    Writes ``config/config.yaml`` (the study model, with its experiment file) and
+    Writes ``config/config.yaml`` (the study model, with its experiment file),
     ``config/experiments/measured.yaml`` (the mean of ``replicates`` truth runs with their
-    scatter and ``noise`` as sd) under ``study_dir``; the truth stays where it is.
+    scatter and the added noise as sd) and ``truth.yaml`` (the drawn truth, which the workflow
+    never reads) under ``study_dir``.
+
+    Parameters
+    ----------
+    noise : mapping, optional
+        Relative noise per observable; default :data:`NOISE`.
+    seed : int
+        Seed of the noise.
+    engine_command : str, optional
+        Engine of the model under calibration (default: the profile's).
+    truth_seed : int
+        Seed of the truth draw.
+    truth_engine : str, optional
+        Command template of the truth runs; default :func:`default_truth_engine`.
 
     Returns
     -------
@@ -138,7 +168,7 @@ def prepare_study(
     path = study_dir / "config" / "config.yaml"
     path.write_text(yaml.safe_dump(config, sort_keys=False))
     validated = validate_config(copy.deepcopy(config), str(path))
-    write_hidden_effect_experiment(
+    _, truth = write_hidden_effect_experiment(
         truth_path,
         validated,
         study_dir / config["experiment"],
@@ -147,26 +177,31 @@ def prepare_study(
         seed,
         workers=workers,
         replicates=replicates,
+        truth_seed=truth_seed,
+        truth_engine=truth_engine if truth_engine is not None else default_truth_engine(),
+    )
+    (study_dir / "truth.yaml").write_text(
+        "# The drawn truth of this study; the workflow never reads it.\n"
+        + yaml.safe_dump(truth.record(), sort_keys=False)
     )
     return path
 
 
 def hidden_effect_bulk(
-    truth: Mapping[str, Any],
+    truth: DrawnTruth,
     config: Mapping[str, Any],
     work_dir: str | Path,
     tests: Sequence[str] = ("shear_cell",),
     workers: int = 2,
     replicates: int = 1,
+    engine_command: str | None = None,
 ) -> pd.DataFrame:
     """Bulk values of the virtual tests at the true parameters with the hidden effect on.
 
     Parameters
     ----------
-    truth : mapping
-        ``parameters`` (case columns), ``switch`` (configuration overrides) and optionally
-        ``profiles`` (per profile, parameter values that replace those of ``parameters``, for
-        an effect of similar strength at another scale).
+    truth : DrawnTruth
+        The drawn truth (:func:`demcal.discrepancy.truths.draw_truth`).
     config : mapping
         The study configuration (the model under calibration).
     work_dir : path
@@ -179,15 +214,19 @@ def hidden_effect_bulk(
     replicates : int
         Repetitions of every run with a different configuration seed (a fresh packing), as a
         laboratory repeats a test; column ``replicate`` numbers them.
+    engine_command : str, optional
+        Command template of the truth runs (e.g. ``liggghts -in {deck}``); default the
+        study's ``engine.command``.
 
     Raises
     ------
     RuntimeError
         When a run fails (names the case directory and the engine's error).
     """
-    cfg = deep_merge(config, truth.get("switch") or {})
-    per_profile = (truth.get("profiles") or {}).get(str(cfg.get("profile")), {})
-    params = {k: float(v) for k, v in {**truth["parameters"], **per_profile}.items()}
+    cfg = truth_config(truth, config)
+    if engine_command is not None:
+        cfg = deep_merge(cfg, {"engine": {"command": engine_command}})
+    params = dict(truth.parameters)
     cases: list[tuple[str, dict[str, Any], int]] = []
     for r in range(replicates):
         if "angle_of_repose" in tests:
@@ -212,12 +251,16 @@ def hidden_effect_bulk(
 
 
 def replicate_record(
-    bulk: pd.DataFrame, material: str, noise: float, seed: int, source: str
+    bulk: pd.DataFrame,
+    material: str,
+    noise: Mapping[str, float],
+    seed: int,
+    source: str,
 ) -> dict[str, Any]:
     """An experiment-file mapping: the mean of the replicates with its standard deviation.
 
-    Every value is the mean over the n replicate runs times (1 + noise * N(0, 1)); its sd is
-    sqrt(s^2 / n + (noise * mean)^2) with s the sample standard deviation of the replicates (0
+    Every value is the mean over the n replicate runs times (1 + noise_k * N(0, 1)); its sd is
+    sqrt(s^2 / n + (noise_k * mean)^2) with s the sample standard deviation of the replicates (0
     for a single run): the standard error of the mean combined with the added noise, the
     uncertainty of the value that is stated.
 
@@ -225,22 +268,24 @@ def replicate_record(
     ----------
     bulk : DataFrame
         Output of :func:`hidden_effect_bulk`.
-    noise : float
-        Relative standard deviation of the added measurement noise.
+    noise : mapping
+        Relative standard deviation of the added noise per observable (``mu_psh``, ``mu_sh``,
+        ``rho_b``, ``aor``; a missing one gets none).
     """
     rng = np.random.default_rng(seed)
 
-    def measured(values: pd.Series) -> tuple[float, float]:
+    def measured(values: pd.Series, name: str) -> tuple[float, float]:
         vals = values.dropna().to_numpy(float)
         mean = float(vals.mean())
         scatter = float(vals.std(ddof=1) / math.sqrt(vals.size)) if vals.size > 1 else 0.0
-        value = mean * (1.0 + noise * rng.standard_normal()) if noise > 0 else mean
-        return value, math.hypot(scatter, noise * mean)
+        level = float(noise.get(name, 0.0))
+        value = mean * (1.0 + level * rng.standard_normal()) if level > 0 else mean
+        return value, math.hypot(scatter, level * mean)
 
     record: dict[str, Any] = {"material": material, "source": source}
     aor = bulk[bulk["test"] == "angle_of_repose"]
     if len(aor) and aor["aor"].notna().any():
-        value, sd = measured(aor["aor"])
+        value, sd = measured(aor["aor"], "aor")
         record["angle_of_repose"] = {"value": round(value, 4), "sd": round(sd, 4)}
     shear = bulk[bulk["test"] == "shear_cell"]
     conditions = []
@@ -248,7 +293,7 @@ def replicate_record(
         entry: dict[str, float] = {"normal_stress": float(stress), "P": float(p)}
         for name in ("mu_psh", "mu_sh", "rho_b"):
             if rows[name].notna().any():
-                value, sd = measured(rows[name])
+                value, sd = measured(rows[name], name)
                 entry[name] = round(value, 6)
                 entry[f"{name}_sd"] = round(sd, 6)
         conditions.append(entry)
@@ -262,31 +307,54 @@ def write_hidden_effect_experiment(
     config: Mapping[str, Any],
     out: str | Path,
     work_dir: str | Path,
-    noise: float,
+    noise: Mapping[str, float] | None,
     seed: int,
     tests: Sequence[str] = ("shear_cell",),
     workers: int = 2,
     replicates: int = 3,
-) -> dict[str, Any]:
-    """Run the truth (``replicates`` times), add noise and write the experiment file ``out``.
+    truth_seed: int = 1,
+    truth_engine: str | None = None,
+) -> tuple[dict[str, Any], DrawnTruth]:
+    """Draw the truth, run it ``replicates`` times, add noise and write the experiment ``out``.
+
+    Parameters
+    ----------
+    truth_path : path
+        Truth specification.
+    config : mapping
+        Validated study configuration.
+    noise : mapping or None
+        Relative noise per observable; None for :data:`NOISE`.
+    seed : int
+        Seed of the noise.
+    truth_seed : int
+        Seed of the truth draw.
+    truth_engine : str, optional
+        Command template of the truth runs; None runs them on the study's engine.
 
     Returns
     -------
-    dict
-        The experiment record written (material, source, measured values with sd).
+    tuple
+        The experiment record written (material, source, measured values with sd) and the
+        drawn truth.
     """
-    truth = yaml.safe_load(Path(truth_path).read_text())
-    bulk = hidden_effect_bulk(truth, config, work_dir, tests, workers, replicates)
+    truth = draw_truth(load_truth_spec(truth_path), config, truth_seed, str(truth_path))
+    noise = dict(NOISE if noise is None else noise)
+    bulk = hidden_effect_bulk(
+        truth, config, work_dir, tests, workers, replicates, engine_command=truth_engine
+    )
+    engine = truth_engine or str(config["engine"]["command"])
+    levels = ", ".join(f"{k} {v:.1%}" for k, v in noise.items())
     record = replicate_record(
         bulk,
-        str(truth["material"]),
+        truth.material,
         noise,
         seed,
-        f"dem_engine with a hidden effect ({config['profile']} profile), mean of {replicates} "
-        f"runs, noise {noise:.1%}",
+        f"`{engine}` with a hidden effect ({config['profile']} profile, truth drawn with seed "
+        f"{truth_seed}), mean of {replicates} runs, noise {levels}",
     )
     Path(out).write_text(
         "# Synthetic measurements with a hidden effect; the truth is kept apart and never read\n"
         "# by the workflow.\n" + yaml.safe_dump(record, sort_keys=False)
     )
-    return record
+    return record, truth

@@ -152,7 +152,7 @@ def test_probe_runs_and_plan_file_lists(study, tmp_path):
     find.write_text('{"missing": true}')
     assert plan.probe_bulk(find) == [
         f"results/discrepancy/probes/shear_cell/{c}_s{k}/bulk.csv"
-        for c in ("ref", "cohesion1", "cohesion2")
+        for c in ("ref", "cohesion1", "cohesion2", "cohesion3")
         for k in (1, 2)
     ]
     ranking = tmp_path / "ranking.json"

@@ -199,15 +199,19 @@ def test_replicate_record_states_mean_and_scatter():
             "rho_b": [1700.0, 1710.0, np.nan],
         }
     )
-    record = replicate_record(bulk, "m", 0.0, 1, "test")
+    record = replicate_record(bulk, "m", {}, 1, "test")
     (entry,) = record["shear_cell"]
     # Standard error of the mean of three: 0.1 / sqrt(3).
     se = 0.1 / math.sqrt(3.0)
     assert entry["mu_psh"] == pytest.approx(0.6) and entry["mu_psh_sd"] == pytest.approx(se)
     assert entry["mu_sh_sd"] == 0.0
     assert entry["rho_b"] == pytest.approx(1705.0)
-    noisy = replicate_record(bulk, "m", 0.01, 1, "test")["shear_cell"][0]
+    noisy = replicate_record(bulk, "m", {"mu_psh": 0.01, "rho_b": 0.02}, 1, "test")
+    noisy = noisy["shear_cell"][0]
     # The sd also covers the added noise: sqrt(se^2 + (0.01 * 0.6)^2).
     assert noisy["mu_psh_sd"] == pytest.approx(math.hypot(se, 0.006), rel=1e-5)
     assert noisy["mu_psh"] != pytest.approx(0.6, abs=1e-9)
+    # Each observable gets its own level; one without a level gets none.
+    assert noisy["rho_b_sd"] == pytest.approx(math.hypot(5.0, 0.02 * 1705.0), rel=1e-5)
+    assert noisy["mu_sh"] == pytest.approx(0.4) and noisy["mu_sh_sd"] == 0.0
     assert "angle_of_repose" not in record

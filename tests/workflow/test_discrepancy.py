@@ -1,11 +1,13 @@
-"""The discrepancy workflow on synthetic data with a hidden effect (tiny scale, real engine).
+"""The discrepancy workflow on synthetic data with a hidden effect (tiny scale).
 
-"Measured" data come from the engine at known parameters with an effect switched on that the
-model under calibration lacks (cohesion; rolling resistance): the mean of three runs per load
-condition from fresh packings, with 0.5 % noise; a third data set has no hidden effect. The
-truth files are read only here and by the study set-up, never by the workflow. The current
-model's design, runs and surrogates are made once and copied into one study directory per data
-set, which then runs `snakemake discrepancy`."""
+"Measured" data come from LIGGGHTS 3.8 at a drawn truth with an effect switched on that the
+model under calibration (on the bundled engine) lacks: cohesion, rolling resistance, or
+nothing. The truth's sliding friction and the effect's magnitude are drawn (seeded) from the
+truth specifications, clear of the catalogue's probe levels; each value is the mean of three
+runs per load condition from fresh packings, with 3 % noise on friction and 1 % on bulk density
+(:data:`demcal.discrepancy.synthetic.NOISE`). The truths are read only here and by the study
+set-up, never by the workflow. The current model's design, runs and surrogates are made once
+and copied into one study directory per data set, which then runs `snakemake discrepancy`."""
 
 import json
 import shutil
@@ -22,6 +24,8 @@ from demcal.core.config import validate_config
 from demcal.core.experiments import load_experiment
 from demcal.discrepancy.synthetic import study_config, write_hidden_effect_experiment
 
+from ..liggghts.conftest import require_liggghts
+
 ROOT = Path(__file__).resolve().parents[2]
 TRUTH = ROOT / "config" / "experiments" / "truth"
 SCENARIOS = {
@@ -29,6 +33,9 @@ SCENARIOS = {
     "rolling": "hidden_rolling.yaml",
     "none": "hidden_none.yaml",
 }
+#: Seed of the truth draws and of the noise.
+TRUTH_SEED = 2026
+TRUTH_ENGINE = "liggghts -in {deck}"
 EXPERIMENT = "config/experiments/measured.yaml"
 OUTPUTS = (
     "find.md",
@@ -93,12 +100,21 @@ def studies(tmp_path_factory) -> dict[str, Path]:
     config["experiment"] = EXPERIMENT
     (base / "config" / "config.yaml").write_text(yaml.safe_dump(config, sort_keys=False))
     validated = validate_config(json.loads(json.dumps(config)), "study config")
-    measured = {}
+    require_liggghts()
+    measured, truths = {}, {}
     for name, truth in SCENARIOS.items():
         measured[name] = base / f"measured_{name}.yaml"
-        write_hidden_effect_experiment(
-            TRUTH / truth, validated, measured[name], base / "truth_runs" / name, 0.005, 1
+        _, truths[name] = write_hidden_effect_experiment(
+            TRUTH / truth,
+            validated,
+            measured[name],
+            base / "truth_runs" / name,
+            None,
+            TRUTH_SEED,
+            truth_seed=TRUTH_SEED,
+            truth_engine=TRUTH_ENGINE,
         )
+        (base / f"truth_{name}.yaml").write_text(yaml.safe_dump(truths[name].record()))
     shutil.copy(measured["none"], base / EXPERIMENT)
     # The current model: design runs and surrogates, shared by all studies.
     snakemake(base, *[f"results/surrogates/{o}/model.pt" for o in ("mu_psh", "mu_sh", "rho_b")])
@@ -137,16 +153,17 @@ def test_all_outputs_written(studies, name):
     assert "parameters" not in yaml.safe_load((studies[name] / EXPERIMENT).read_text())
 
 
-# Known failures since the shear-cell readout measures the bulk (docs/virtual-tests.md): with
-# mu no longer inflated by the upper tube's wall friction, hidden cohesion 5e4 J/m^3 is named as
-# rolling resistance (dBIC 31.1 against 27.9 for cohesion, tiny scale). Hidden rolling
-# resistance is named (dBIC 11.3, magnitude 0.16 for a truth of 0.2, surrogate gap 2.62 -> 0.56),
-# but the DEM run of the extended model misses the data by more than the model without it
-# (gap 3.22 against 2.61). Both are the weaknesses the discrepancy validation (independent
-# LIGGGHTS data, drawn truths, replicate DEM checks, calibrated decisions) has to remove;
-# strict, so that a change that makes them pass is noticed.
+# Known failures. On these honest data (LIGGGHTS truths, drawn with seed 2026: sliding friction
+# 0.339 in all three, hidden cohesion 32 560 J/m^3, hidden rolling resistance 0.163; 3 % noise
+# on friction, 1 % on bulk density) the tiny workflow does not name the hidden effect: with
+# cohesion the gap is 1.49, "within noise" (rho_b at 1 068 Pa is 3 % below the model's reach,
+# z = 3.3, but the friction values carry sigma of about 0.05); with rolling resistance it finds
+# a gap of 2.12 but rolling scores dBIC 5.6 < 6 at a magnitude of 0.05, so nothing is named.
+# These are the weaknesses the discrepancy validation (calibrated decisions, replicate DEM
+# checks, a validation matrix) has to remove; strict, so that a change that makes them pass is
+# noticed.
 _KNOWN = pytest.mark.xfail(
-    strict=True, reason="hidden cohesion named as rolling; rolling's DEM check misses"
+    strict=True, reason="honest tiny data: cohesion within noise, rolling below dBIC 6"
 )
 
 
@@ -160,9 +177,8 @@ def test_hidden_effect_is_named_and_gap_shrinks(studies, name):
     assert result["gap_ratio"] >= 3.0, (result["gap_before"], result["gap_after"])
     # The DEM runs agree: the extended model at its identified point is closer to the data.
     assert result["dem_gap_after"] < result["dem_gap_before"], result
-    truth = yaml.safe_load((TRUTH / SCENARIOS[name]).read_text())["parameters"]
-    parameter = result["parameter"]
-    assert 0.4 * truth[parameter] <= result["magnitude"] <= 2.0 * truth[parameter], result
+    truth = yaml.safe_load((studies[name] / f"truth_{name}.yaml").read_text())["magnitude"]
+    assert 0.4 * truth <= result["magnitude"] <= 2.0 * truth, (result, truth)
     ranking = pd.read_csv(studies[name] / "results" / "discrepancy" / "ranking.csv")
     named = ranking[ranking["status"] == "named"]
     assert list(named["candidate"]) == [name]
@@ -180,9 +196,20 @@ def test_no_hidden_effect_names_none(studies):
 
 
 def test_cohesion_signature_weakens_with_stress(studies):
-    ranking = pd.read_csv(studies["cohesion"] / "results" / "discrepancy" / "ranking.csv")
-    signature = ranking.set_index("candidate").loc["cohesion", "signature"]
-    # Cohesion loosens a packing (the packing fraction of spheres falls as the cohesive force
-    # grows against the weight, Yang, Zou & Yu 2000) and its extra shear strength is a larger
-    # share of the stress at low normal stress.
-    assert "rho_b -" in signature and "weakens with normal stress" in signature, signature
+    # Every study that reached the naming step probed cohesion at its theta*: the signature is
+    # the engine's response to cohesion there, whichever effect was hidden.
+    probed = {}
+    for name, work in studies.items():
+        path = work / "results" / "discrepancy" / "ranking.csv"
+        ranking = pd.read_csv(path) if path.is_file() else pd.DataFrame()
+        if "signature" in ranking and "cohesion" in set(ranking["candidate"]):
+            probed[name] = ranking.set_index("candidate").loc["cohesion", "signature"]
+    assert probed, "no study reached the naming step"
+    for name, signature in probed.items():
+        # Cohesion loosens a packing (the packing fraction of spheres falls as the cohesive
+        # force grows against the weight, Yang, Zou & Yu 2000) and its extra shear strength is
+        # a larger share of the stress at low normal stress.
+        assert "rho_b -" in signature and "weakens with normal stress" in signature, (
+            name,
+            signature,
+        )

@@ -1,0 +1,143 @@
+"""Hidden truths are drawn away from the probe levels, inside ranges that extend past them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+from demcal.discrepancy.truths import (
+    MAX_EFFECT_FRACTION,
+    draw_truth,
+    load_truth_spec,
+    truth_config,
+)
+
+ROOT = Path(__file__).resolve().parents[2]
+TRUTHS = ROOT / "config" / "experiments" / "truth"
+
+CONFIG = {
+    "profile": "tiny",
+    "particles": {"classes": 1, "distribution": "monodisperse"},
+    "material": {"rolling_friction": False},
+    "design": {"ranges": {"coefficientFriction": [0.1, 0.9]}},
+    "discrepancy": {
+        "candidates": [
+            {
+                "name": "cohesion",
+                "description": "c",
+                "parameter": "cohesionEnergyDensity",
+                "off_value": 0.0,
+                "range": [0.0, 100000.0],
+                "probe_levels": [20000.0, 50000.0, 80000.0],
+            },
+            {
+                "name": "rolling",
+                "description": "r",
+                "switch": {"material": {"rolling_friction": True}},
+                "parameter": "coefficientRollingFriction",
+                "off_value": 0.0,
+                "range": [0.0, 0.4],
+                "probe_levels": [0.1, 0.2, 0.3],
+            },
+            {
+                "name": "polydispersity",
+                "description": "p",
+                "switch": {"particles": {"distribution": "sinter_fines"}},
+                "parameter": "sizeClasses",
+                "config_key": "particles.classes",
+                "off_value": 1,
+                "range": [1, 6],
+                "probe_levels": [2, 4, 6],
+                "integer": True,
+            },
+        ]
+    },
+}
+
+
+def spec(effect: str | None, **extra) -> dict:
+    return {
+        "material": "m",
+        "effect": effect,
+        "parameters": {"coefficientRestitution": 0.7},
+        "draw": {"coefficientFriction": [0.25, 0.75]},
+        **extra,
+    }
+
+
+def test_drawn_magnitudes_keep_clear_of_probe_levels_and_inside_the_span() -> None:
+    magnitudes = [draw_truth(spec("cohesion"), CONFIG, seed).magnitude for seed in range(200)]
+    assert all(m is not None for m in magnitudes)
+    # Default span: 15-70 % of the range; clearance 5 % of the range from 20 000 and 50 000.
+    assert min(magnitudes) >= 15000.0 and max(magnitudes) <= 70000.0
+    assert all(abs(m - level) > 5000.0 for m in magnitudes for level in (20000.0, 50000.0))
+    # Drawn, not chosen: what is left of the span, [25 000, 45 000] and [55 000, 70 000], is
+    # covered to its ends.
+    assert min(magnitudes) < 27000.0 and max(magnitudes) > 68000.0
+    assert any(43000.0 < m for m in magnitudes if m < 50000.0)
+    assert any(m < 57000.0 for m in magnitudes if m > 50000.0)
+
+
+def test_the_same_seed_gives_the_same_truth_and_another_seed_another() -> None:
+    a, b = draw_truth(spec("rolling"), CONFIG, 7), draw_truth(spec("rolling"), CONFIG, 7)
+    c = draw_truth(spec("rolling"), CONFIG, 8)
+    assert a == b and a.magnitude != c.magnitude
+    assert a.parameters["coefficientRollingFriction"] == a.magnitude
+    assert 0.25 <= a.parameters["coefficientFriction"] <= 0.75
+    assert a.parameters["coefficientRestitution"] == 0.7
+    assert a.drawn == {
+        "coefficientFriction": a.parameters["coefficientFriction"],
+        "coefficientRollingFriction": a.magnitude,
+    }
+
+
+def test_the_effect_is_switched_on_as_the_workflow_would_add_it() -> None:
+    rolling = draw_truth(spec("rolling"), CONFIG, 1)
+    assert truth_config(rolling, CONFIG)["material"]["rolling_friction"] is True
+    poly = draw_truth(spec("polydispersity"), CONFIG, 3)
+    # A whole number of classes away from the probe levels 2, 4, 6 within 15-70 % of [1, 6].
+    assert poly.magnitude == 3.0 and "sizeClasses" not in poly.parameters
+    config = truth_config(poly, CONFIG)
+    assert config["particles"] == {"classes": 3, "distribution": "sinter_fines"}
+    nothing = draw_truth(spec(None), CONFIG, 1)
+    assert nothing.magnitude is None and truth_config(nothing, CONFIG) == CONFIG
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        ({"effect_span": [0.2, 1.0]}, "must extend past the truth"),
+        ({"effect_span": [0.5, 0.3]}, "must satisfy"),
+        ({"draw": {"coefficientFriction": [0.05, 0.5]}}, "leaves the design range"),
+        ({"probe_clearance": 0.3}, "leave no room"),
+    ],
+)
+def test_truths_that_would_make_the_check_trivial_are_refused(extra: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        draw_truth(spec("cohesion", **extra), CONFIG, 1, "truth.yaml")
+
+
+def test_an_effect_outside_the_catalogue_is_refused_by_name() -> None:
+    with pytest.raises(ValueError, match=r"truth\.yaml: effect 'moisture' is not a candidate"):
+        draw_truth(spec("moisture"), CONFIG, 1, "truth.yaml")
+
+
+def test_shipped_truth_specifications_draw_on_both_profiles() -> None:
+    for name in ("tiny", "config"):
+        config = yaml.safe_load((ROOT / "config" / f"{name}.yaml").read_text())
+        if name == "config":
+            config["profile"] = "quick"
+        for path in sorted(TRUTHS.glob("hidden_*.yaml")):
+            truth = draw_truth(load_truth_spec(path), config, 1, str(path))
+            assert truth.effect == yaml.safe_load(path.read_text())["effect"], path
+            if truth.magnitude is not None:
+                levels = next(
+                    c["probe_levels"]
+                    for c in config["discrepancy"]["candidates"]
+                    if c["name"] == truth.effect
+                )
+                assert len(levels) >= 3, (name, truth.effect)
+                assert truth.magnitude not in levels
+    assert MAX_EFFECT_FRACTION <= 0.8
