@@ -14,6 +14,11 @@ Over the parameter box (a regular grid, then a bounded local refinement of the b
 * the gap figure G = sqrt(chi^2(theta*) / N): about 1 or less when the model explains the data
   within its uncertainty, clearly above 1 when it cannot;
 * the verdict: G <= threshold means the disagreement is within the noise and nothing is missing.
+
+A verdict needs more measured values than the box has free parameters: with N <= d the best fit
+can match N values exactly whatever the material lacks, so Find then says that the data are too
+few (and how many are needed) instead of "nothing missing". Naming an effect adds one parameter,
+so it needs N >= d + 2.
 """
 
 from __future__ import annotations
@@ -56,6 +61,8 @@ class FindResult:
         on the boundary of the box.
     pinned : dict[str, str]
         Parameters of theta* on a bound of the box: name -> "lower" or "upper".
+    n_free : int
+        Free parameters of the box (axes with a non-zero width), d.
     """
 
     observations: pd.DataFrame
@@ -64,19 +71,36 @@ class FindResult:
     threshold: float
     sentences: list[str]
     pinned: dict[str, str] = field(default_factory=dict)
+    n_free: int = 0
+
+    @property
+    def too_few(self) -> bool:
+        """True when N <= d: the best fit can match every value, so no verdict is possible."""
+        return len(self.observations) <= self.n_free
 
     @property
     def missing(self) -> bool:
-        """True when the gap exceeds the threshold (something is missing)."""
-        return self.gap > self.threshold
+        """True when the gap exceeds the threshold (something is missing) on enough data."""
+        return not self.too_few and self.gap > self.threshold
 
     @property
     def verdict(self) -> str:
-        if self.missing:
+        n, d = len(self.observations), self.n_free
+        if self.too_few:
             return (
+                f"{n} measured value{'s' if n != 1 else ''} for {d} free parameter"
+                f"{'s' if d != 1 else ''}: too few for a verdict (the best fit can match them "
+                f"whatever is missing) -> measure at least {d + 1} values (another load "
+                f"condition, P or the angle of repose), {d + 2} to name a missing effect"
+            )
+        if self.missing:
+            text = (
                 f"gap {self.gap:.2f} > {self.threshold:g}: the model cannot reproduce the "
                 "measurements within their uncertainty -> a physical effect is missing"
             )
+            if n < d + 2:
+                text += f" (naming it needs at least {d + 2} measured values, {n} given)"
+            return text
         text = f"gap {self.gap:.2f} <= {self.threshold:g}: within noise -> nothing missing"
         if self.pinned:
             text += f", but theta* sits on the box boundary ({', '.join(self.pinned)})"
@@ -147,7 +171,8 @@ def find(
     sentences = describe_disagreement(obs, fit_z)
     if pinned:
         sentences.append(describe_pinned(pinned, box))
-    return FindResult(obs, best, gap, gap_threshold, sentences, pinned)
+    n_free = sum(1 for lo, hi in box.bounds.values() if hi > lo)
+    return FindResult(obs, best, gap, gap_threshold, sentences, pinned, n_free)
 
 
 _NAMES = {

@@ -131,6 +131,8 @@ def find_record(result: FindResult, box: ParameterBox, config: Mapping[str, Any]
         "threshold": result.threshold,
         "chi2": result.best.deviance,
         "n_observations": len(result.observations),
+        "n_free": result.n_free,
+        "too_few": result.too_few,
         "theta": result.best.theta,
         "point": base_point(result.best.theta, config),
         "bounds": {k: list(v) for k, v in box.bounds.items()},

@@ -97,9 +97,7 @@ def rank(
             "left out (no value in the reference run): "
             + ", ".join(f"{r.observable} at {r.normal_stress:g} Pa" for r in dropped.itertuples())
         )
-        model = SurrogateModel(
-            surrogates, obs[keep], model.parameters, surrogate_constants(config)
-        )
+        model = SurrogateModel(surrogates, obs[keep], model.parameters, surrogate_constants(config))
         obs = model.observations
         reference = reference[keep]
     null = find(
@@ -171,6 +169,13 @@ def rank(
     if winner_name is not None and unscored:
         notes.append(
             f"{winner_name} leads, but is not named: {', '.join(unscored)} could not be scored"
+        )
+        winner_name = None
+    if winner_name is not None and len(obs) < null.n_free + 2:
+        # A candidate adds one parameter: with N <= d + 1 it can fit every value exactly.
+        notes.append(
+            f"{winner_name} leads, but is not named: {len(obs)} measured values cannot tell "
+            f"{null.n_free + 1} fitted parameters apart (at least {null.n_free + 2} needed)"
         )
         winner_name = None
     info = pd.DataFrame(rows)

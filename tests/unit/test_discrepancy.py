@@ -194,3 +194,22 @@ def test_describe_disagreement_conflict_direction():
 def test_format_stress_groups_thousands():
     assert format_stress(10070.0) == "10 070 Pa"
     assert format_stress(1068.4) == "1 068 Pa"
+
+
+def test_find_says_when_the_data_are_too_few_for_a_verdict():
+    # Two free parameters, two measured values: the best fit matches both exactly, whatever
+    # the material lacks, so Find must not say "nothing missing".
+    exp = experiment(0.5, 3000.0, lambda name, s: 0.6 if name == "mu_psh" else 0.0)
+    obs = observation_table(exp, {"mu_psh": 0.005, "rho_b": 4.0}, 0.05)
+    two = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1]], BOX.names), BOX, 21, 1.5)
+    assert two.n_free == 2 and two.too_few and not two.missing
+    assert two.verdict.startswith("2 measured values for 2 free parameters: too few")
+    assert "measure at least 3 values" in two.verdict and "4 to name" in two.verdict
+    # A third value, unreachable, gives a verdict, with the note that naming needs a fourth.
+    three = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1, 2]], BOX.names), BOX, 21, 1.5)
+    assert not three.too_few and three.missing
+    assert "naming it needs at least 4 measured values, 3 given" in three.verdict
+    # A fixed axis is not a free parameter.
+    fixed = ParameterBox({"coefficientFriction": (0.1, 1.0), "density": (3000.0, 3000.0)})
+    one = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1]], BOX.names), fixed, 21, 1.5)
+    assert one.n_free == 1 and not one.too_few
