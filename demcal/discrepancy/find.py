@@ -13,7 +13,12 @@ Over the parameter box (a regular grid, then a bounded local refinement of the b
 * the joint best point theta* = argmin chi^2, chi^2 = sum_k z_k^2;
 * the gap figure G = sqrt(chi^2(theta*) / N): about 1 or less when the model explains the data
   within its uncertainty, clearly above 1 when it cannot;
-* the verdict: G <= threshold means the disagreement is within the noise and nothing is missing.
+* the verdict, from a parametric bootstrap of "nothing missing": data sets drawn as
+  y* = f(theta*) + sigma * N(0, 1) are fitted over the same grid, and p is the share of them
+  whose best chi^2 reaches the observed one. Something is missing when p < alpha, so that on
+  data the model does describe the verdict is wrong in a share alpha of the cases, whatever N
+  and the number of parameters (a fixed threshold on G has a false-alarm rate that depends on
+  both, and is far from its large-N value at the few values a shear test gives).
 
 A verdict needs more measured values than the box has free parameters: with N <= d the best fit
 can match N values exactly whatever the material lacks, so Find then says that the data are too
@@ -38,6 +43,7 @@ __all__ = [
     "describe_disagreement",
     "describe_pinned",
     "find",
+    "null_deviances",
 ]
 
 
@@ -54,8 +60,9 @@ class FindResult:
         theta* and chi^2(theta*).
     gap : float
         sqrt(chi^2(theta*) / K).
-    threshold : float
-        Gap at or below which the disagreement counts as noise.
+    alpha : float
+        Significance level of the verdict (its false-alarm rate on data without a missing
+        effect).
     sentences : list[str]
         Where the disagreement sits, one sentence per observable, and one more when theta* sits
         on the boundary of the box.
@@ -63,15 +70,22 @@ class FindResult:
         Parameters of theta* on a bound of the box: name -> "lower" or "upper".
     n_free : int
         Free parameters of the box (axes with a non-zero width), d.
+    p_value : float
+        Share of the bootstrap data sets of "nothing missing" whose best grid chi^2 reaches the
+        observed one (counting the observed set itself).
+    draws : int
+        Bootstrap data sets.
     """
 
     observations: pd.DataFrame
     best: BestFit
     gap: float
-    threshold: float
+    alpha: float
     sentences: list[str]
     pinned: dict[str, str] = field(default_factory=dict)
     n_free: int = 0
+    p_value: float = 1.0
+    draws: int = 0
 
     @property
     def too_few(self) -> bool:
@@ -80,8 +94,8 @@ class FindResult:
 
     @property
     def missing(self) -> bool:
-        """True when the gap exceeds the threshold (something is missing) on enough data."""
-        return not self.too_few and self.gap > self.threshold
+        """True when "nothing missing" is rejected at ``alpha`` on enough data."""
+        return not self.too_few and self.p_value < self.alpha
 
     @property
     def verdict(self) -> str:
@@ -93,15 +107,16 @@ class FindResult:
                 f"whatever is missing) -> measure at least {d + 1} values (another load "
                 f"condition, P or the angle of repose), {d + 2} to name a missing effect"
             )
+        test = f"gap {self.gap:.2f}, p = {self.p_value:.3g}"
         if self.missing:
             text = (
-                f"gap {self.gap:.2f} > {self.threshold:g}: the model cannot reproduce the "
-                "measurements within their uncertainty -> a physical effect is missing"
+                f"{test} < {self.alpha:g}: the model cannot reproduce the measurements within "
+                "their uncertainty -> a physical effect is missing"
             )
             if n < d + 2:
                 text += f" (naming it needs at least {d + 2} measured values, {n} given)"
             return text
-        text = f"gap {self.gap:.2f} <= {self.threshold:g}: within noise -> nothing missing"
+        text = f"{test} >= {self.alpha:g}: within noise -> nothing missing"
         if self.pinned:
             text += f", but theta* sits on the box boundary ({', '.join(self.pinned)})"
         return text
@@ -120,13 +135,53 @@ def describe_pinned(pinned: Mapping[str, str], box: ParameterBox) -> str:
     )
 
 
+def null_deviances(
+    predictions: np.ndarray, fitted: np.ndarray, sigma: np.ndarray, draws: int, seed: int
+) -> np.ndarray:
+    """Best grid chi^2 of data sets drawn under "nothing missing" (parametric bootstrap).
+
+    Parameters
+    ----------
+    predictions : ndarray, shape (G, K)
+        Model predictions at the G grid points.
+    fitted : ndarray, shape (K,)
+        Predictions at the best fit, the data's expectation under "nothing missing".
+    sigma : ndarray, shape (K,)
+        Uncertainties of the K values.
+    draws : int
+        Data sets drawn, y* = fitted + sigma * N(0, 1).
+    seed : int
+        Seed of the draws.
+
+    Returns
+    -------
+    ndarray, shape (draws,)
+        min over the grid of chi^2(y*) for each data set.
+    """
+    rng = np.random.default_rng(seed)
+    scaled = predictions / sigma
+    norms = np.sum(scaled**2, axis=1)
+    out = np.empty(draws)
+    # chi^2_g = |a_g|^2 - 2 a_g . u + |u|^2 with a = F / sigma, u = y* / sigma; chunks keep the
+    # (G, chunk) product small.
+    chunk = max(1, min(draws, 20_000_000 // max(1, scaled.shape[0])))
+    for start in range(0, draws, chunk):
+        n = min(chunk, draws - start)
+        u = fitted / sigma + rng.standard_normal((n, fitted.size))
+        best = np.min(norms[:, None] - 2.0 * scaled @ u.T, axis=0)
+        out[start : start + n] = np.maximum(best + np.sum(u**2, axis=1), 0.0)
+    return out
+
+
 def find(
     model: SurrogateModel,
     box: ParameterBox,
     grid_points: int,
-    gap_threshold: float,
+    alpha: float = 0.05,
     fit_z: float = 2.0,
     refine: bool = True,
+    draws: int = 1000,
+    seed: int = 0,
 ) -> FindResult:
     """Best achievable misfit per observation, the joint best point and the gap figure.
 
@@ -138,13 +193,21 @@ def find(
         The parameter box, with the names of ``model.parameters`` in the same order.
     grid_points : int
         Points per continuous axis of the regular grid.
-    gap_threshold : float
-        The verdict threshold on the gap figure.
+    alpha : float
+        Significance level of the verdict.
     fit_z : float
         |z| at or below which an observation counts as fitted in the sentences.
     refine : bool
         Refine theta* with L-BFGS-B from the best grid point.
+    draws : int
+        Bootstrap data sets of the verdict (the p-value resolves 1 / (draws + 1)).
+    seed : int
+        Seed of the bootstrap.
     """
+    if not 0.0 < alpha < 1.0:
+        raise ValueError(f"alpha must lie in (0, 1), got {alpha}")
+    if draws < 1:
+        raise ValueError(f"draws must be at least 1, got {draws}")
     if box.names != model.parameters:
         raise ValueError(f"box parameters {box.names} differ from model's {model.parameters}")
     obs = model.observations.copy()
@@ -172,7 +235,11 @@ def find(
     if pinned:
         sentences.append(describe_pinned(pinned, box))
     n_free = sum(1 for lo, hi in box.bounds.values() if hi > lo)
-    return FindResult(obs, best, gap, gap_threshold, sentences, pinned, n_free)
+    # The observed statistic is the grid minimum, as for the bootstrap sets.
+    g0 = int(np.argmin(chi2))
+    null = null_deviances(F, F[g0], sigma, draws, seed)
+    p_value = float((1 + np.count_nonzero(null >= chi2[g0])) / (draws + 1))
+    return FindResult(obs, best, gap, alpha, sentences, pinned, n_free, p_value, draws)
 
 
 _NAMES = {

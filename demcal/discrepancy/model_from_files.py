@@ -116,8 +116,9 @@ def find_from_files(
         model,
         box,
         int(settings["grid_points"]),
-        float(settings["gap_threshold"]),
+        float(settings["alpha"]),
         float(settings["fit_z"]),
+        draws=int(settings["bootstrap_draws"]),
     )
     return result, model, box
 
@@ -128,7 +129,9 @@ def find_record(result: FindResult, box: ParameterBox, config: Mapping[str, Any]
         "missing": result.missing,
         "verdict": result.verdict,
         "gap": result.gap,
-        "threshold": result.threshold,
+        "alpha": result.alpha,
+        "p_value": result.p_value,
+        "draws": result.draws,
         "chi2": result.best.deviance,
         "n_observations": len(result.observations),
         "n_free": result.n_free,

@@ -140,7 +140,7 @@ class DiscrepancyPlan:
 
 
 def missing(find_record: str | Path) -> bool:
-    """Whether Find found the gap above its threshold."""
+    """Whether Find rejected "nothing missing"."""
     return bool(json.loads(Path(find_record).read_text())["missing"])
 
 

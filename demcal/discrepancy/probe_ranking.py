@@ -104,8 +104,9 @@ def rank(
         model,
         box,
         int(settings["grid_points"]),
-        float(settings["gap_threshold"]),
+        float(settings["alpha"]),
         float(settings["fit_z"]),
+        draws=int(settings["bootstrap_draws"]),
     )
     grid = box.grid(int(settings["grid_points"]))
     predictions = model.predict(grid)

@@ -61,8 +61,10 @@ def find_markdown(result: FindResult, material: str, box_bounds: Mapping[str, An
         f"**Verdict: {result.verdict}.**",
         "",
         f"Gap figure G = sqrt(min chi^2 / N) = sqrt({result.best.deviance:.3g} / {len(obs)}) "
-        f"= {result.gap:.3f} (threshold {result.threshold:g}); z = (model - measured) / sigma "
-        "with sigma = sqrt(measurement sd^2 + surrogate held-out RMSE^2).",
+        f"= {result.gap:.3f}; z = (model - measured) / sigma with sigma = sqrt(measurement "
+        'sd^2 + surrogate held-out RMSE^2). Verdict: p-value of "nothing missing" from '
+        f"{result.draws} data sets drawn at theta* with these sigma and fitted over the same "
+        f"grid, p = {result.p_value:.3g} against alpha = {result.alpha:g}.",
         "",
         "Where the disagreement sits:",
         "",

@@ -106,7 +106,7 @@ def test_minimise_chi2_refines_a_quadratic_to_its_minimum():
 
 
 def test_find_recovers_the_truth_and_says_nothing_is_missing():
-    result = find(model_for(experiment(0.37, 2890.0)), BOX, 31, gap_threshold=1.5)
+    result = find(model_for(experiment(0.37, 2890.0)), BOX, 31)
     assert result.best.theta["coefficientFriction"] == pytest.approx(0.37, abs=1e-3)
     assert result.best.theta["density"] == pytest.approx(2890.0, abs=2.0)
     assert result.gap < 0.05
@@ -115,7 +115,7 @@ def test_find_recovers_the_truth_and_says_nothing_is_missing():
 
 
 def test_find_inside_the_box_pins_nothing():
-    result = find(model_for(experiment(0.37, 2890.0)), BOX, 31, gap_threshold=1.5)
+    result = find(model_for(experiment(0.37, 2890.0)), BOX, 31)
     assert result.pinned == {}
     assert "boundary" not in result.verdict
 
@@ -124,7 +124,7 @@ def test_find_flags_a_best_fit_on_the_box_boundary():
     # The material's density, 3 800 kg/m^3, lies above the box (2 500-3 500): the fit stops
     # at the upper bound and can still look like noise when the bulk densities are uncertain.
     exp = experiment(0.37, 3800.0)
-    result = find(model_for(exp), BOX, 31, gap_threshold=1e3)
+    result = find(model_for(exp), BOX, 31, alpha=1e-6)
     assert result.best.theta["density"] == pytest.approx(3500.0)
     assert result.pinned == {"density": "upper"}
     assert not result.missing
@@ -144,7 +144,7 @@ def test_pinned_parameters_tolerance_and_single_valued_axes():
 def test_find_matches_brute_force_over_the_grid():
     exp = experiment(0.5, 3000.0, lambda name, s: 0.1 * 1068.0 / s if name == "mu_psh" else 0.0)
     model = model_for(exp)
-    result = find(model, BOX, 21, gap_threshold=1.5, refine=False)
+    result = find(model, BOX, 21, refine=False)
     grid = BOX.grid(21)
     y = model.observations["measured"].to_numpy()
     sigma = model.observations["sigma"].to_numpy()
@@ -160,7 +160,7 @@ def test_find_reports_unreachable_measurements_with_percentage():
     exp = experiment(
         0.5, 3000.0, lambda name, s: 0.6 if (name == "mu_psh" and s == 1068.0) else 0.0
     )
-    result = find(model_for(exp), BOX, 21, gap_threshold=1.5)
+    result = find(model_for(exp), BOX, 21)
     assert result.missing
     sentence = next(s for s in result.sentences if s.startswith("mu_psh"))
     assert "at 1 068 Pa (P = 0.5, 1) is 38 % above anything the model reaches" in sentence
@@ -201,15 +201,49 @@ def test_find_says_when_the_data_are_too_few_for_a_verdict():
     # the material lacks, so Find must not say "nothing missing".
     exp = experiment(0.5, 3000.0, lambda name, s: 0.6 if name == "mu_psh" else 0.0)
     obs = observation_table(exp, {"mu_psh": 0.005, "rho_b": 4.0}, 0.05)
-    two = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1]], BOX.names), BOX, 21, 1.5)
+    two = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1]], BOX.names), BOX, 21)
     assert two.n_free == 2 and two.too_few and not two.missing
     assert two.verdict.startswith("2 measured values for 2 free parameters: too few")
     assert "measure at least 3 values" in two.verdict and "4 to name" in two.verdict
     # A third value, unreachable, gives a verdict, with the note that naming needs a fourth.
-    three = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1, 2]], BOX.names), BOX, 21, 1.5)
+    three = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1, 2]], BOX.names), BOX, 21)
     assert not three.too_few and three.missing
     assert "naming it needs at least 4 measured values, 3 given" in three.verdict
     # A fixed axis is not a free parameter.
     fixed = ParameterBox({"coefficientFriction": (0.1, 1.0), "density": (3000.0, 3000.0)})
-    one = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1]], BOX.names), fixed, 21, 1.5)
+    one = find(SurrogateModel(SURROGATES, obs.iloc[[0, 1]], BOX.names), fixed, 21)
     assert one.n_free == 1 and not one.too_few
+
+
+def _noisy_model(shift: float, rng: np.random.Generator) -> SurrogateModel:
+    """The analytic material at (0.5, 3000) measured with Gaussian noise of the stated sigma,
+    mu_psh raised by ``shift`` at the lowest stress (an effect the model lacks)."""
+    obs = observation_table(
+        experiment(0.5, 3000.0, lambda n, s: shift if (n == "mu_psh" and s == 1068.0) else 0.0),
+        {"mu_psh": 0.005, "rho_b": 4.0},
+        0.05,
+    )
+    obs["measured"] = obs["measured"] + obs["sigma"] * rng.standard_normal(len(obs))
+    return SurrogateModel(SURROGATES, obs, BOX.names)
+
+
+def test_find_false_alarm_rate_is_alpha_and_an_effect_is_found():
+    # 300 data sets the model describes (N = 12 values, d = 2 parameters): "nothing missing"
+    # is rejected in about alpha of them. Binomial(300, 0.05) lies in [4, 29] with probability
+    # 0.999, so the test fails by chance about once in a thousand runs (the seeds are fixed).
+    rng = np.random.default_rng(11)
+    verdicts = [
+        find(_noisy_model(0.0, rng), BOX, 21, alpha=0.05, refine=False, draws=199, seed=k)
+        for k in range(300)
+    ]
+    false_alarms = sum(r.missing for r in verdicts)
+    assert 4 <= false_alarms <= 29, false_alarms
+    p = np.array([r.p_value for r in verdicts])
+    # Under "nothing missing" the p-values are uniform: a fifth below 0.2, half below 0.5.
+    assert 0.13 <= np.mean(p < 0.2) <= 0.27 and 0.42 <= np.mean(p < 0.5) <= 0.58
+    # mu_psh 0.05 (about 3 sigma) too high at one stress in both P: found nearly every time.
+    found = [
+        find(_noisy_model(0.05, rng), BOX, 21, alpha=0.05, refine=False, draws=199, seed=k).missing
+        for k in range(50)
+    ]
+    assert sum(found) >= 45, sum(found)

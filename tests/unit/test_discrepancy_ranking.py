@@ -156,7 +156,7 @@ def test_ranking_requires_a_share_of_the_misfit():
 def test_null_fit_with_find_weights_equals_find():
     model, grid, F = setup(magnitude=1.0)
     weights = model.observations["sigma"].to_numpy()
-    result = find(model, BOX, 31, gap_threshold=1.5)
+    result = find(model, BOX, 31)
     assert null_fit(model, BOX, grid, F, weights).deviance == pytest.approx(
         result.best.deviance, rel=1e-6
     )
