@@ -302,8 +302,9 @@ void Simulation::run(const Command& command) {
       os << deep_overlaps_.steps() << " of " << this_run
          << " steps of this run had a contact overlapping by more than "
          << format_g(100.0 * DeepOverlaps::kRatio, 3) << " % of a radius, from step "
-         << deep_overlaps_.first_step() << "; deepest " << format_g(100.0 * deep_overlaps_.worst(), 3)
-         << " %, particle " << deep_overlaps_.tag() << " against " << deep_overlaps_.partner();
+         << deep_overlaps_.first_step() << "; deepest "
+         << format_g(100.0 * deep_overlaps_.worst(), 3) << " %, particle " << deep_overlaps_.tag()
+         << " against " << deep_overlaps_.partner();
       warning(os.str());
       deep_overlaps_.clear();
     }
