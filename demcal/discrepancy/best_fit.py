@@ -17,6 +17,7 @@ from scipy.optimize import minimize
 __all__ = [
     "BestFit",
     "ParameterBox",
+    "best_deviances",
     "grid_size",
     "minimise_chi2",
     "pinned_parameters",
@@ -189,3 +190,33 @@ def pinned_parameters(
 def grid_size(box: ParameterBox, points: int) -> int:
     """Number of grid points of ``box`` at ``points`` per continuous axis."""
     return math.prod(len(v) for v in box.axes(points).values())
+
+
+def best_deviances(rows: np.ndarray, data: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """For each data set, the smallest weighted squared misfit over candidate predictions.
+
+    Parameters
+    ----------
+    rows : ndarray, shape (R, K)
+        Predictions of the K values, one row per candidate point (e.g. a parameter grid).
+    data : ndarray, shape (B, K)
+        Data sets.
+    weights : ndarray, shape (K,)
+        Standard deviation of each value.
+
+    Returns
+    -------
+    ndarray, shape (B,)
+        min over the rows of sum_k ((data_bk - rows_rk) / weights_k)^2.
+    """
+    scaled = np.asarray(rows, float) / weights
+    norms = np.sum(scaled**2, axis=1)
+    u_all = np.atleast_2d(np.asarray(data, float)) / weights
+    out = np.empty(u_all.shape[0])
+    # |a - u|^2 = |a|^2 - 2 a.u + |u|^2; chunks of data sets keep the (R, chunk) product small.
+    chunk = max(1, min(u_all.shape[0], 20_000_000 // max(1, scaled.shape[0])))
+    for start in range(0, u_all.shape[0], chunk):
+        u = u_all[start : start + chunk]
+        best = np.min(norms[:, None] - 2.0 * scaled @ u.T, axis=0)
+        out[start : start + len(u)] = np.maximum(best + np.sum(u**2, axis=1), 0.0)
+    return out

@@ -35,7 +35,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from demcal.discrepancy.best_fit import BestFit, ParameterBox, minimise_chi2, pinned_parameters
+from demcal.discrepancy.best_fit import (
+    BestFit,
+    ParameterBox,
+    best_deviances,
+    minimise_chi2,
+    pinned_parameters,
+)
 from demcal.discrepancy.observations import OBSERVABLES, SurrogateModel, format_stress
 
 __all__ = [
@@ -159,18 +165,8 @@ def null_deviances(
         min over the grid of chi^2(y*) for each data set.
     """
     rng = np.random.default_rng(seed)
-    scaled = predictions / sigma
-    norms = np.sum(scaled**2, axis=1)
-    out = np.empty(draws)
-    # chi^2_g = |a_g|^2 - 2 a_g . u + |u|^2 with a = F / sigma, u = y* / sigma; chunks keep the
-    # (G, chunk) product small.
-    chunk = max(1, min(draws, 20_000_000 // max(1, scaled.shape[0])))
-    for start in range(0, draws, chunk):
-        n = min(chunk, draws - start)
-        u = fitted / sigma + rng.standard_normal((n, fitted.size))
-        best = np.min(norms[:, None] - 2.0 * scaled @ u.T, axis=0)
-        out[start : start + n] = np.maximum(best + np.sum(u**2, axis=1), 0.0)
-    return out
+    data = fitted + sigma * rng.standard_normal((draws, fitted.size))
+    return best_deviances(predictions, data, sigma)
 
 
 def find(

@@ -29,8 +29,15 @@ from demcal.discrepancy.model_from_files import (
     load_surrogates,
     surrogate_constants,
 )
-from demcal.discrepancy.observations import SurrogateModel
-from demcal.discrepancy.ranking import fit_candidate, null_fit, rank_candidates, ranking_sigma
+from demcal.discrepancy.observations import SurrogateModel, format_stress
+from demcal.discrepancy.ranking import (
+    NamingTest,
+    fit_candidate,
+    naming_test,
+    null_fit,
+    rank_candidates,
+    ranking_sigma,
+)
 from demcal.discrepancy.report import ranking_markdown
 from demcal.discrepancy.run_results import read_runs, run_values
 
@@ -55,6 +62,8 @@ class RankingResult:
         Deviance D_0 of "nothing missing" with the ranking weights.
     notes : list[str]
         Observations or probe levels left out, and why.
+    test : NamingTest or None
+        The bootstrap tests of the naming decision (None when no candidate was scored).
     """
 
     table: pd.DataFrame
@@ -63,6 +72,7 @@ class RankingResult:
     find: FindResult
     null_deviance: float
     notes: list[str] = field(default_factory=list)
+    test: NamingTest | None = None
 
 
 def rank(
@@ -115,6 +125,7 @@ def rank(
     null_weighted = null_fit(model, box, grid, predictions, weights)
     point = {k: float(v) for k, v in probe_point.items()}
     fits = {}
+    responses: dict[str, EffectResponse] = {}
     rows = []
     for cand in candidates:
         row: dict[str, Any] = {
@@ -157,14 +168,12 @@ def rank(
             int(settings["magnitude_points"]),
         )
         fits[cand.name] = fit
+        responses[cand.name] = response
         signature = response_signature(obs, response, reference, noise)
         rows.append({**row, "status": "scored", "signature": signature})
+    # dBIC orders the candidates; the bootstrap tests below decide whether the top one is named.
     scored, winner_name = rank_candidates(
-        null_weighted.deviance,
-        fits,
-        len(obs),
-        float(settings["min_delta_bic"]),
-        float(settings["min_explained"]),
+        null_weighted.deviance, fits, len(obs), -np.inf, float(settings["min_explained"])
     )
     unscored = [r["candidate"] for r in rows if r["status"].startswith("not scored")]
     if winner_name is not None and unscored:
@@ -172,6 +181,18 @@ def rank(
             f"{winner_name} leads, but is not named: {', '.join(unscored)} could not be scored"
         )
         winner_name = None
+    test = None
+    if responses:
+        test = naming_test(
+            predictions,
+            obs["measured"].to_numpy(float),
+            weights,
+            responses,
+            int(settings["magnitude_points"]),
+            int(settings["bootstrap_draws"]),
+        )
+    if winner_name is not None and test is not None:
+        winner_name = _tested_winner(winner_name, test, float(settings["alpha"]), obs, notes)
     if winner_name is not None and len(obs) < null.n_free + 2:
         # A candidate adds one parameter: with N <= d + 1 it can fit every value exactly.
         notes.append(
@@ -187,7 +208,37 @@ def rank(
         table.loc[table["status"] == "scored", "named"], "named", "not significant"
     )
     winner = next((c for c in candidates if c.name == winner_name), None)
-    return RankingResult(table, winner, fits, null, null_weighted.deviance, notes)
+    return RankingResult(table, winner, fits, null, null_weighted.deviance, notes, test)
+
+
+def _value_label(row: Any) -> str:
+    if not np.isfinite(float(row["normal_stress"])):
+        return str(row["observable"])
+    return f"{row['observable']} at {format_stress(row['normal_stress'])}, P = {row['P']:g}"
+
+
+def _tested_winner(
+    leader: str, test: NamingTest, alpha: float, obs: pd.DataFrame, notes: list[str]
+) -> str | None:
+    """The leader if both bootstrap tests reject at ``alpha``, else None (with a note why)."""
+    if test.p_effect >= alpha:
+        notes.append(
+            f"{leader} leads, but is not named: noise alone gives as large an improvement "
+            f"(p = {test.p_effect:.3g} >= {alpha:g}, {test.draws} data sets drawn under "
+            "'nothing missing')"
+        )
+        return None
+    if test.runner_up is not None and test.p_runner_up is not None:
+        if test.p_runner_up >= alpha:
+            where = _value_label(obs.iloc[test.separating]) if test.separating is not None else ""
+            notes.append(
+                f"{test.top} and {test.runner_up} cannot be told apart (p = "
+                f"{test.p_runner_up:.3g} >= {alpha:g} that {test.runner_up} fits this much worse "
+                f"by chance): their fits differ most in {where}; repeating that measurement or "
+                "measuring near it separates them best"
+            )
+            return None
+    return leader
 
 
 def ranking_record(result: RankingResult) -> dict[str, Any]:
@@ -199,6 +250,9 @@ def ranking_record(result: RankingResult) -> dict[str, Any]:
         "n_observations": len(result.find.observations),
         "null_deviance": result.null_deviance,
         "notes": result.notes,
+        "p_effect": result.test.p_effect if result.test else None,
+        "runner_up": result.test.runner_up if result.test else None,
+        "p_runner_up": result.test.p_runner_up if result.test else None,
         "ranking": [
             {
                 "candidate": r.candidate,
@@ -289,7 +343,7 @@ def write_ranking(
             result.table,
             result.winner.name if result.winner else None,
             len(result.find.observations),
-            float(settings["min_delta_bic"]),
+            float(settings["alpha"]),
             float(settings["min_explained"]),
             result.notes,
         )

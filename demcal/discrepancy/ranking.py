@@ -25,9 +25,23 @@ Bayes factor of the candidate over "nothing missing" (Schwarz 1978; Kass & Rafte
 6 strong, above 10 very strong evidence). BIC rather than AIC because its penalty grows with
 the number of observations and it targets the question asked here (which model is true, not
 which predicts best), so it is the more conservative of the two against naming an effect that
-is not there. A candidate is named only when its dBIC reaches a threshold, it removes at least
-a given share of D_0, and every applicable candidate could be scored (otherwise the best of the
-scored ones need not be the right one).
+is not there. dBIC orders the candidates; whether the top one is named is decided by two
+parametric-bootstrap tests whose error rates are known at the few values a shear test gives
+(:func:`naming_test`):
+
+* **Is there an effect?** Data sets drawn under "nothing missing" (the current model at its
+  best grid point, with the ranking weights) are fitted by the current model and by every
+  candidate; p_effect is the share whose largest deviance drop max_c (D_0 - D_c) reaches the
+  observed one. The maximum over the candidates accounts for having picked the best of several.
+* **Is it this effect, not the runner-up?** Data sets drawn from the runner-up's best fit are
+  fitted by both; p_runner_up is the share in which the runner-up's deviance exceeds the top
+  candidate's by at least the observed amount. When it is not below alpha the two cannot be told
+  apart, and the measured value where their fits differ most (in units of its weight) is the one
+  whose repetition or neighbourhood would separate them best.
+
+A candidate is named only when both p-values are below alpha, it removes at least a given share
+of D_0, and every applicable candidate could be scored (otherwise the best of the scored ones
+need not be the right one).
 """
 
 from __future__ import annotations
@@ -39,13 +53,15 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from demcal.discrepancy.best_fit import BestFit, ParameterBox, minimise_chi2
+from demcal.discrepancy.best_fit import BestFit, ParameterBox, best_deviances, minimise_chi2
 from demcal.discrepancy.effect_response import EffectResponse
 from demcal.discrepancy.observations import SurrogateModel
 
 __all__ = [
     "CandidateFit",
+    "NamingTest",
     "fit_candidate",
+    "naming_test",
     "null_fit",
     "rank_candidates",
     "ranking_sigma",
@@ -232,3 +248,105 @@ def rank_candidates(
         winner = str(table["candidate"].iloc[0])
     table["named"] = table["candidate"] == winner
     return table, winner
+
+
+@dataclass
+class NamingTest:
+    """The bootstrap tests behind naming the top candidate (see the module documentation).
+
+    Attributes
+    ----------
+    top : str
+        Candidate with the largest deviance drop on the grid.
+    p_effect : float
+        p-value of "nothing missing" against the best of the candidates.
+    runner_up : str or None
+        Second candidate (None with a single candidate).
+    p_runner_up : float or None
+        p-value of "the runner-up is the effect" against the top candidate.
+    separating : int or None
+        Index of the measured value where the two fits differ most in units of its weight.
+    draws : int
+        Bootstrap data sets per test.
+    """
+
+    top: str
+    p_effect: float
+    runner_up: str | None
+    p_runner_up: float | None
+    separating: int | None
+    draws: int
+
+
+def _candidate_rows(
+    grid_predictions: np.ndarray, response: EffectResponse, magnitude_points: int
+) -> list[np.ndarray]:
+    return [grid_predictions + response.at(a) for a in response.trial_magnitudes(magnitude_points)]
+
+
+def _best(rows: list[np.ndarray], data: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    out = np.full(np.atleast_2d(data).shape[0], np.inf)
+    for block in rows:
+        out = np.minimum(out, best_deviances(block, data, weights))
+    return out
+
+
+def _best_row(rows: list[np.ndarray], y: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    stacked = np.vstack(rows)
+    return stacked[int(np.argmin(np.sum(((stacked - y) / weights) ** 2, axis=1)))]
+
+
+def naming_test(
+    grid_predictions: np.ndarray,
+    y: np.ndarray,
+    weights: np.ndarray,
+    responses: Mapping[str, EffectResponse],
+    magnitude_points: int = 41,
+    draws: int = 1000,
+    seed: int = 0,
+) -> NamingTest:
+    """Parametric-bootstrap tests for naming the candidate that explains most of the misfit.
+
+    Parameters
+    ----------
+    grid_predictions : ndarray, shape (G, K)
+        The current model's predictions over the parameter grid.
+    y : ndarray, shape (K,)
+        Measured values.
+    weights : ndarray, shape (K,)
+        Ranking weights (:func:`ranking_sigma`).
+    responses : mapping
+        Candidate name -> DEM response; at least one.
+    magnitude_points : int
+        Magnitudes tried per continuous candidate, as in :func:`fit_candidate`.
+    draws : int
+        Bootstrap data sets per test.
+    seed : int
+        Seed of the draws.
+    """
+    if not responses:
+        raise ValueError("naming_test needs at least one candidate")
+    rng = np.random.default_rng(seed)
+    w = np.asarray(weights, float)
+    y = np.asarray(y, float)
+    rows = {c: _candidate_rows(grid_predictions, r, magnitude_points) for c, r in responses.items()}
+    d0 = float(best_deviances(grid_predictions, y, w)[0])
+    dc = {c: float(_best(r, y, w)[0]) for c, r in rows.items()}
+    order = sorted(dc, key=lambda c: dc[c])
+    top = order[0]
+    # Is there an effect: the largest drop over all candidates, under "nothing missing".
+    null_point = _best_row([grid_predictions], y, w)
+    data = null_point + w * rng.standard_normal((draws, y.size))
+    null_d0 = best_deviances(grid_predictions, data, w)
+    drops = np.max([null_d0 - _best(r, data, w) for r in rows.values()], axis=0)
+    p_effect = float((1 + np.count_nonzero(drops >= d0 - dc[top])) / (draws + 1))
+    if len(order) < 2:
+        return NamingTest(top, p_effect, None, None, None, draws)
+    # Is it the top candidate rather than the runner-up: data drawn from the runner-up's fit.
+    second = order[1]
+    top_point, second_point = _best_row(rows[top], y, w), _best_row(rows[second], y, w)
+    data = second_point + w * rng.standard_normal((draws, y.size))
+    gaps = _best(rows[second], data, w) - _best(rows[top], data, w)
+    p_second = float((1 + np.count_nonzero(gaps >= dc[second] - dc[top])) / (draws + 1))
+    separating = int(np.argmax(np.abs(top_point - second_point) / w))
+    return NamingTest(top, p_effect, second, p_second, separating, draws)

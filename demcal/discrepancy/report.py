@@ -99,7 +99,7 @@ def ranking_markdown(
     table: pd.DataFrame,
     winner: str | None,
     n_observations: int,
-    min_delta_bic: float,
+    alpha: float,
     min_explained: float = 0.0,
     notes: Sequence[str] = (),
     verdict: str | None = None,
@@ -114,8 +114,10 @@ def ranking_markdown(
         "Score: dBIC = D_0 - D_c - ln N against 'nothing missing' (one extra parameter; "
         f"N = {n_observations}, ln N = {penalty:.2f}), D = sum ((model - measured) / s)^2 with "
         "s^2 = sigma^2 + 2 RMSE^2 (a probe response is the difference of two DEM runs); "
-        "explained = share of D_0 removed; gap = sqrt(D_c / N). A candidate is named when "
-        f"dBIC >= {min_delta_bic:g} and explained >= {min_explained:g}.",
+        "explained = share of D_0 removed; gap = sqrt(D_c / N). dBIC orders the candidates; "
+        "the top one is named when a parametric bootstrap rejects both 'nothing missing' and "
+        f"'the runner-up is the effect' at alpha = {alpha:g}, and explained >= "
+        f"{min_explained:g}.",
         "",
         f"**Named: {winner}.**" if winner else "**No candidate beats 'nothing missing' clearly.**",
         "",

@@ -10,7 +10,13 @@ from demcal.discrepancy.best_fit import ParameterBox
 from demcal.discrepancy.effect_response import EffectResponse, response_signature
 from demcal.discrepancy.find import find
 from demcal.discrepancy.observations import SurrogateModel, observation_table
-from demcal.discrepancy.ranking import fit_candidate, null_fit, rank_candidates, ranking_sigma
+from demcal.discrepancy.ranking import (
+    fit_candidate,
+    naming_test,
+    null_fit,
+    rank_candidates,
+    ranking_sigma,
+)
 
 FEATURES = ["coefficientFriction", "density", "normal_stress", "P"]
 STRESSES = (1068.0, 2029.0, 10070.0)
@@ -179,3 +185,61 @@ def test_signature_ignores_responses_within_the_noise():
     noise = np.where(model.observations["observable"] == "rho_b", 4.0, 0.005)
     text = response_signature(model.observations, resp, np.full(len(noise), 1.0), noise)
     assert text == "mu_psh no clear change; rho_b no clear change"
+
+
+# --- the bootstrap naming tests, on a linear model with known truths ---------------------------
+
+_K = 8
+_THETA = np.linspace(0.0, 1.0, 41)
+_GRID = np.outer(_THETA, np.linspace(1.0, 2.0, _K))  # the current model: f_k(t) = t * (1 + k/7)
+_W = np.full(_K, 0.05)
+
+
+def _response(name: str, shape: np.ndarray) -> EffectResponse:
+    # Probe levels 1 and 2 of an effect that shifts the values by magnitude * shape.
+    return EffectResponse.from_runs(name, [0.0, 1.0, 2.0], np.outer([0.0, 1.0, 2.0], shape), 0)
+
+
+_A = _response("a", np.where(np.arange(_K) < 4, 0.15, 0.0))  # acts on the first half only
+_B = _response("b", np.linspace(0.15, -0.15, _K))  # a tilt across all values
+_C = _response("c", np.where(np.arange(_K) < 4, 0.15, 0.0) + 1e-4)  # a copy of a
+
+
+def _data(rng, truth: np.ndarray) -> np.ndarray:
+    return truth + _W * rng.standard_normal(_K)
+
+
+def test_naming_false_alarm_rate_is_alpha_without_an_effect():
+    # 200 data sets of the current model at t = 0.5: the best of two candidates is named in
+    # about alpha of them. Binomial(200, 0.05) lies in [2, 21] with probability 0.999.
+    rng = np.random.default_rng(5)
+    tests = [
+        naming_test(_GRID, _data(rng, _GRID[20]), _W, {"a": _A, "b": _B}, 41, 199, seed=k)
+        for k in range(200)
+    ]
+    alarms = sum(t.p_effect < 0.05 for t in tests)
+    assert 2 <= alarms <= 21, alarms
+
+
+def test_naming_finds_the_hidden_effect_and_tells_it_from_the_runner_up():
+    rng = np.random.default_rng(6)
+    truth = _GRID[20] + _A.at(1.8)  # 0.27 (5.4 sigma) on four values
+    tests = [
+        naming_test(_GRID, _data(rng, truth), _W, {"a": _A, "b": _B}, 41, 199, k) for k in range(40)
+    ]
+    named = [t for t in tests if t.top == "a" and t.p_effect < 0.05 and t.p_runner_up < 0.05]
+    assert len(named) >= 36, [(t.top, t.p_effect, t.p_runner_up) for t in tests]
+    assert all(t.runner_up == "b" for t in named)
+
+
+def test_naming_reports_two_candidates_that_cannot_be_told_apart():
+    # c acts like a: the data cannot separate them, so naming must not pick one, and the value
+    # that separates them best is one where they differ (the second half, where c adds 1e-4).
+    rng = np.random.default_rng(7)
+    truth = _GRID[20] + _A.at(1.3)
+    tests = [
+        naming_test(_GRID, _data(rng, truth), _W, {"a": _A, "c": _C}, 41, 199, k) for k in range(40)
+    ]
+    assert all(t.p_effect < 0.05 for t in tests)
+    ambiguous = [t for t in tests if t.p_runner_up >= 0.05]
+    assert len(ambiguous) >= 36, [t.p_runner_up for t in tests]

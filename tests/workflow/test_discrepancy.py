@@ -157,13 +157,15 @@ def test_all_outputs_written(studies, name):
 # Known failures. On these honest data (LIGGGHTS truths, drawn with seed 2026: sliding friction
 # 0.339 in all three, hidden cohesion 32 560 J/m^3, hidden rolling resistance 0.163; 3 % noise
 # on friction, 1 % on bulk density) Find is right in all three studies (p = 0.017 with
-# cohesion, 0.001 with rolling resistance, 0.72 with nothing hidden), but no effect is named:
-# with cohesion every candidate scores dBIC < 0 (cohesion fitted at 3 250 J/m^3, 7 % of the
-# misfit explained); with rolling resistance the top candidate, rolling at 0.05, scores dBIC
-# 5.6 < 6. These are the weaknesses the discrepancy validation (a calibrated naming decision,
-# replicate probe and DEM runs, a validation matrix) has to remove; strict, so that a change
-# that makes them pass is noticed.
-_KNOWN = pytest.mark.xfail(strict=True, reason="honest tiny data: Find right, but no effect named")
+# cohesion, 0.001 with rolling resistance, 0.72 with nothing hidden). Hidden rolling resistance
+# is named (p_effect 0.010, against cohesion p 0.002) and the DEM gap shrinks from 2.11 to
+# 0.71, but the surrogate gap only from 2.12 to 0.61 (ratio 2.2 < 3) and the fitted magnitude is
+# 0.062, 0.38 of the truth. Hidden cohesion is not named (p_effect 0.31). These are the
+# weaknesses the discrepancy validation (replicate probe runs, a validation matrix) has to
+# remove; strict, so that a change that makes them pass is noticed.
+_KNOWN = pytest.mark.xfail(
+    strict=True, reason="honest tiny data: cohesion not named, rolling named with 0.38x magnitude"
+)
 
 
 @pytest.mark.parametrize(
@@ -181,7 +183,8 @@ def test_hidden_effect_is_named_and_gap_shrinks(studies, name):
     ranking = pd.read_csv(studies[name] / "results" / "discrepancy" / "ranking.csv")
     named = ranking[ranking["status"] == "named"]
     assert list(named["candidate"]) == [name]
-    assert named["delta_bic"].iloc[0] >= 6.0
+    record = json.loads((studies[name] / "results" / "discrepancy" / "ranking.json").read_text())
+    assert record["p_effect"] < 0.05 and record["p_runner_up"] < 0.05, record
 
 
 def test_no_hidden_effect_names_none(studies):
