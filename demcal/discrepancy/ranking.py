@@ -278,22 +278,33 @@ class NamingTest:
     draws: int
 
 
-def _candidate_rows(
-    grid_predictions: np.ndarray, response: EffectResponse, magnitude_points: int
-) -> list[np.ndarray]:
-    return [grid_predictions + response.at(a) for a in response.trial_magnitudes(magnitude_points)]
+def _offsets(response: EffectResponse, magnitude_points: int) -> list[np.ndarray]:
+    """The candidate's response at each trial magnitude, shape (K,) each."""
+    return [response.at(a) for a in response.trial_magnitudes(magnitude_points)]
 
 
-def _best(rows: list[np.ndarray], data: np.ndarray, weights: np.ndarray) -> np.ndarray:
+# A candidate's predictions are the grid's plus one offset per magnitude; they are formed one
+# magnitude at a time, as (G, K) blocks, rather than all at once.
+def _best(
+    grid: np.ndarray, offsets: list[np.ndarray], data: np.ndarray, weights: np.ndarray
+) -> np.ndarray:
     out = np.full(np.atleast_2d(data).shape[0], np.inf)
-    for block in rows:
-        out = np.minimum(out, best_deviances(block, data, weights))
+    for offset in offsets:
+        out = np.minimum(out, best_deviances(grid + offset, data, weights))
     return out
 
 
-def _best_row(rows: list[np.ndarray], y: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    stacked = np.vstack(rows)
-    return stacked[int(np.argmin(np.sum(((stacked - y) / weights) ** 2, axis=1)))]
+def _best_row(
+    grid: np.ndarray, offsets: list[np.ndarray], y: np.ndarray, weights: np.ndarray
+) -> np.ndarray:
+    best_value, best_row = np.inf, grid[0]
+    for offset in offsets:
+        block = grid + offset
+        values = np.sum(((block - y) / weights) ** 2, axis=1)
+        j = int(np.argmin(values))
+        if values[j] < best_value:
+            best_value, best_row = float(values[j]), block[j]
+    return best_row
 
 
 def naming_test(
@@ -329,24 +340,29 @@ def naming_test(
     rng = np.random.default_rng(seed)
     w = np.asarray(weights, float)
     y = np.asarray(y, float)
-    rows = {c: _candidate_rows(grid_predictions, r, magnitude_points) for c, r in responses.items()}
+    offsets = {c: _offsets(r, magnitude_points) for c, r in responses.items()}
     d0 = float(best_deviances(grid_predictions, y, w)[0])
-    dc = {c: float(_best(r, y, w)[0]) for c, r in rows.items()}
+    dc = {c: float(_best(grid_predictions, o, y, w)[0]) for c, o in offsets.items()}
     order = sorted(dc, key=lambda c: dc[c])
     top = order[0]
     # Is there an effect: the largest drop over all candidates, under "nothing missing".
-    null_point = _best_row([grid_predictions], y, w)
+    null_point = _best_row(grid_predictions, [np.zeros_like(y)], y, w)
     data = null_point + w * rng.standard_normal((draws, y.size))
     null_d0 = best_deviances(grid_predictions, data, w)
-    drops = np.max([null_d0 - _best(r, data, w) for r in rows.values()], axis=0)
+    drops = np.max(
+        [null_d0 - _best(grid_predictions, o, data, w) for o in offsets.values()], axis=0
+    )
     p_effect = float((1 + np.count_nonzero(drops >= d0 - dc[top])) / (draws + 1))
     if len(order) < 2:
         return NamingTest(top, p_effect, None, None, None, draws)
     # Is it the top candidate rather than the runner-up: data drawn from the runner-up's fit.
     second = order[1]
-    top_point, second_point = _best_row(rows[top], y, w), _best_row(rows[second], y, w)
+    top_point = _best_row(grid_predictions, offsets[top], y, w)
+    second_point = _best_row(grid_predictions, offsets[second], y, w)
     data = second_point + w * rng.standard_normal((draws, y.size))
-    gaps = _best(rows[second], data, w) - _best(rows[top], data, w)
+    gaps = _best(grid_predictions, offsets[second], data, w) - _best(
+        grid_predictions, offsets[top], data, w
+    )
     p_second = float((1 + np.count_nonzero(gaps >= dc[second] - dc[top])) / (draws + 1))
     separating = int(np.argmax(np.abs(top_point - second_point) / w))
     return NamingTest(top, p_effect, second, p_second, separating, draws)
