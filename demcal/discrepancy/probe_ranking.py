@@ -29,7 +29,7 @@ from demcal.discrepancy.model_from_files import (
     load_surrogates,
     surrogate_constants,
 )
-from demcal.discrepancy.observations import SurrogateModel, format_stress
+from demcal.discrepancy.observations import SurrogateModel
 from demcal.discrepancy.ranking import (
     NamingTest,
     fit_candidate,
@@ -38,7 +38,7 @@ from demcal.discrepancy.ranking import (
     rank_candidates,
     ranking_sigma,
 )
-from demcal.discrepancy.report import ranking_markdown
+from demcal.discrepancy.report import condition_label, ranking_markdown
 from demcal.discrepancy.run_results import read_runs, run_values
 
 __all__ = ["RankingResult", "rank", "ranking_record", "write_ranking"]
@@ -211,12 +211,6 @@ def rank(
     return RankingResult(table, winner, fits, null, null_weighted.deviance, notes, test)
 
 
-def _value_label(row: Any) -> str:
-    if not np.isfinite(float(row["normal_stress"])):
-        return str(row["observable"])
-    return f"{row['observable']} at {format_stress(row['normal_stress'])}, P = {row['P']:g}"
-
-
 def _tested_winner(
     leader: str, test: NamingTest, alpha: float, obs: pd.DataFrame, notes: list[str]
 ) -> str | None:
@@ -230,7 +224,11 @@ def _tested_winner(
         return None
     if test.runner_up is not None and test.p_runner_up is not None:
         if test.p_runner_up >= alpha:
-            where = _value_label(obs.iloc[test.separating]) if test.separating is not None else ""
+            where = ""
+            if test.separating is not None:
+                row = obs.iloc[test.separating]
+                label = condition_label(row)
+                where = row["observable"] + ("" if label == "-" else f" at {label}")
             notes.append(
                 f"{test.top} and {test.runner_up} cannot be told apart (p = "
                 f"{test.p_runner_up:.3g} >= {alpha:g} that {test.runner_up} fits this much worse "

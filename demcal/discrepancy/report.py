@@ -19,6 +19,7 @@ from demcal.discrepancy.observations import format_stress
 
 __all__ = [
     "KEY_COLUMNS",
+    "condition_label",
     "find_markdown",
     "gap_figure",
     "gap_of",
@@ -46,7 +47,8 @@ def markdown_table(frame: pd.DataFrame, floatfmt: str = ".4g") -> str:
     return "\n".join([header, rule, *body]) + "\n"
 
 
-def _condition(row: Any) -> str:
+def condition_label(row: Any) -> str:
+    """A load condition as text, e.g. ``1 068 Pa, P = 0.5`` (``-`` for the angle of repose)."""
     if not math.isfinite(row.normal_stress):
         return "-"
     return f"{format_stress(row.normal_stress)}, P = {row.P:g}"
@@ -79,7 +81,7 @@ def find_markdown(result: FindResult, material: str, box_bounds: Mapping[str, An
     table = pd.DataFrame(
         {
             "observable": obs["observable"],
-            "condition": [_condition(r) for r in obs.itertuples()],
+            "condition": [condition_label(r) for r in obs.itertuples()],
             "measured": obs["measured"],
             "sigma": obs["sigma"],
             "model range": [
