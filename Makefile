@@ -10,7 +10,7 @@ ENGINE_SOURCES := $(shell find dem_engine/src dem_engine/CMakeLists.txt -type f 
 CORES ?= all
 SNAKEMAKE_ARGS ?=
 
-.PHONY: setup sysdeps engine run test lint bench convergence docs clean
+.PHONY: setup sysdeps engine run test lint bench convergence discrepancy-matrix docs clean
 
 setup: $(PY_STAMP) sysdeps engine
 
@@ -55,6 +55,14 @@ CONVERGENCE_ARGS ?=
 convergence: setup
 	source $(VENV)/bin/activate && python scripts/convergence_study.py --config config/config.yaml \
 		--out results/convergence/quick $(CONVERGENCE_ARGS)
+
+# Validation matrix of the discrepancy workflow: hidden effects x drawn truths, data from
+# LIGGGHTS (MATRIX_PROFILE=config/config.yaml for the quick scale; resumable).
+MATRIX_PROFILE ?= config/tiny.yaml
+MATRIX_ARGS ?= --truths 5
+discrepancy-matrix: setup
+	source $(VENV)/bin/activate && python scripts/discrepancy_matrix.py --profile $(MATRIX_PROFILE) \
+		--out results/matrix/$(basename $(notdir $(MATRIX_PROFILE))) $(MATRIX_ARGS)
 
 # The configuration reference, generated from the schema (tests/unit/test_docs.py checks it).
 docs: $(PY_STAMP)

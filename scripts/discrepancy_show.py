@@ -21,6 +21,7 @@ def main(snakemake) -> None:
             recalibration_path=inp.get("recalibration"),
             after_table_path=inp.get("after_table"),
             verification_files=inp.get("verification"),
+            experiment_path=inp.experiment,
         )
         logger.info("summary: %s", summary)
 

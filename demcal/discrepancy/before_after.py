@@ -11,13 +11,48 @@ from typing import Any
 
 import pandas as pd
 
+from demcal.core.experiments import Experiment, load_experiment
 from demcal.core.provenance import write_sidecar
 from demcal.discrepancy.candidates import REFERENCE_CASE
+from demcal.discrepancy.dem_check import held_out_experiment, replicate_bases
+from demcal.discrepancy.observations import observation_table
 from demcal.discrepancy.plan import VERIFICATION_CASE
-from demcal.discrepancy.report import gap_figure, gap_of, gap_table, verification_markdown
-from demcal.discrepancy.run_results import read_runs, run_values
+from demcal.discrepancy.report import (
+    condition_label,
+    gap_figure,
+    gap_of,
+    gap_table,
+    verification_markdown,
+)
+from demcal.discrepancy.run_results import read_runs, replicate_statistics
 
-__all__ = ["gap_title", "show", "write_before_after"]
+__all__ = ["gap_title", "held_out_rows", "show", "write_before_after"]
+
+
+def held_out_rows(
+    before: pd.DataFrame, experiment: Experiment, config: Mapping[str, Any]
+) -> pd.DataFrame:
+    """Observations of the held-out loads, on the same sigma as the fitted ones.
+
+    sigma = sqrt(measurement sd^2 + surrogate held-out RMSE^2) with the RMSE of the same
+    observable in ``before`` (the Find table), so that a held-out misfit reads like a fitted
+    one. No surrogate value is given (``at_best`` NaN): these loads are checked by DEM only.
+
+    Returns
+    -------
+    DataFrame, shape (H, ...)
+        Columns of :func:`demcal.discrepancy.observations.observation_table` plus at_best,
+        z_at_best (NaN) and held_out (True); empty without held-out loads.
+    """
+    held = held_out_experiment(experiment, config)
+    if not held.shear_conditions:
+        return pd.DataFrame(columns=[*before.columns, "held_out"])
+    rmse = before.groupby("observable")["surrogate_rmse"].first().to_dict()
+    measured = [o for o in held.outputs if o in rmse]
+    rows = observation_table(
+        held, rmse, float(config["screening"]["tolerance"]), observables=measured
+    )
+    return rows.assign(at_best=math.nan, z_at_best=math.nan, held_out=True)
 
 
 def show(
@@ -28,6 +63,8 @@ def show(
     recal_rec: Mapping[str, Any] | None,
     reference_runs: pd.DataFrame,
     verification_runs: pd.DataFrame,
+    held_out: pd.DataFrame | None = None,
+    replicates: int = 1,
 ) -> tuple[pd.DataFrame, dict[str, Any]]:
     """The before/after table and the summary of a discrepancy study.
 
@@ -38,13 +75,27 @@ def show(
     find_rec, ranking_rec, recal_rec : mapping
         Records of Find, Name and the recalibration (None when nothing was added).
     reference_runs, verification_runs : DataFrame
-        Probe reference runs at theta* and verification runs (may be empty).
+        Replicates of the reference run at theta* and of the verification run (may be empty).
+    held_out : DataFrame or None
+        Observations of the held-out loads (:func:`held_out_rows`).
+    replicates : int
+        Replicate runs per point (``discrepancy.replicates``).
     """
-    dem_before = run_values(reference_runs, REFERENCE_CASE, before)
-    dem_after = (
-        run_values(verification_runs, VERIFICATION_CASE, before) if recal_rec is not None else None
+    observed = before.assign(held_out=False)
+    if held_out is not None and len(held_out):
+        observed = pd.concat([observed, held_out], ignore_index=True, sort=False)
+    dem_before = replicate_statistics(
+        reference_runs, replicate_bases(REFERENCE_CASE, replicates), observed
     )
-    table = gap_table(before, after, dem_before, dem_after)
+    dem_after = (
+        replicate_statistics(
+            verification_runs, replicate_bases(VERIFICATION_CASE, replicates), observed
+        )
+        if recal_rec is not None
+        else None
+    )
+    table = gap_table(observed, after, dem_before, dem_after)
+    fitted, held = table[~table["held_out"]], table[table["held_out"]]
     summary: dict[str, Any] = {
         "missing": bool(find_rec["missing"]),
         "verdict": find_rec["verdict"],
@@ -54,7 +105,10 @@ def show(
         "theta_before": find_rec["theta"],
         "winner": ranking_rec.get("winner"),
         "ranking": ranking_rec.get("ranking", []),
-        "dem_gap_before": gap_of(table["z_dem_before"]),
+        "replicates": int(replicates),
+        "held_out": sorted({condition_label(r) for r in held.itertuples()}),
+        "dem_gap_before": gap_of(fitted["z_dem_before"]),
+        "held_out_dem_gap_before": gap_of(held["z_dem_before"]),
         "extended": recal_rec is not None,
     }
     if recal_rec is None:
@@ -64,9 +118,9 @@ def show(
             else "no candidate beats 'nothing missing' clearly"
         )
         return table, summary
-    gap_before = gap_of(table["z_before_common"])
-    gap_after = gap_of(table["z_after_common"])
-    dem_after_gap = gap_of(table["z_dem_after"])
+    gap_before = gap_of(fitted["z_before_common"])
+    gap_after = gap_of(fitted["z_after_common"])
+    dem_after_gap = gap_of(fitted["z_dem_after"])
     summary.update(
         {
             "parameter": recal_rec["parameter"],
@@ -80,6 +134,7 @@ def show(
             "dem_gap_ratio": summary["dem_gap_before"] / dem_after_gap
             if dem_after_gap > 0
             else math.inf,
+            "held_out_dem_gap_after": gap_of(held["z_dem_after"]),
             "verdict_after": recal_rec["verdict"],
             "screening_after": recal_rec.get("screening"),
         }
@@ -110,6 +165,7 @@ def write_before_after(
     recalibration_path: str | Path | None = None,
     after_table_path: str | Path | None = None,
     verification_files: Iterable[str | Path] | None = None,
+    experiment_path: str | Path | None = None,
 ) -> dict[str, Any]:
     """Write the before/after table, its figure, the verification report and the summary.
 
@@ -129,6 +185,8 @@ def write_before_after(
         Record and per-observation table of the extended model; None when no effect was added.
     verification_files : iterable of path or None
         ``bulk.csv`` of the verification runs of the extended model.
+    experiment_path : path or None
+        The experiment file (for the held-out loads); default ``config["experiment"]``.
 
     Returns
     -------
@@ -136,14 +194,18 @@ def write_before_after(
         The summary written.
     """
     extended = recalibration_path is not None
+    before = pd.read_csv(find_table_path)
+    experiment = load_experiment(experiment_path or config["experiment"])
     table, summary = show(
-        pd.read_csv(find_table_path),
+        before,
         json.loads(Path(find_record_path).read_text()),
         json.loads(Path(ranking_record_path).read_text()),
         pd.read_csv(after_table_path) if extended else None,
         json.loads(Path(recalibration_path).read_text()) if extended else None,
         read_runs(reference_files),
         read_runs(verification_files or []) if extended else pd.DataFrame(),
+        held_out_rows(before, experiment, config),
+        int(config["discrepancy"]["replicates"]),
     )
     table.to_csv(table_path, index=False, float_format="%.6g")
     gap_figure(table, gap_title(summary), figure_path)

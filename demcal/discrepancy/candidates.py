@@ -27,6 +27,7 @@ from demcal.core.experiments import Experiment
 from demcal.core.parameters import CONTACT_PARAMETERS
 from demcal.design.build import build_design
 from demcal.design.cases import design_spec, load_condition, shear_suffixes
+from demcal.discrepancy.dem_check import run_load, run_seed
 
 __all__ = [
     "REFERENCE_CASE",
@@ -296,9 +297,10 @@ def case_setup(
     ----------
     test : {"shear_cell", "angle_of_repose"}
     case_id : str
-        Case id; a shear-cell id carries its load condition as in the design's cases
-        (``_s<k>`` and, for separate runs, ``_p<j>``; see
-        :func:`demcal.design.cases.load_condition`).
+        Case id (:func:`demcal.discrepancy.dem_check.parse_run_id`): ``_r<k>`` marks
+        replicate k (its own insertion seed); a shear-cell id carries its load condition as in
+        the design's cases (``_s<k>`` and, for separate runs, ``_p<j>``) or ``_h<m>``, the m-th
+        held-out condition.
     point : mapping
         Complete parameter set (see :func:`base_point`).
     config : mapping
@@ -328,8 +330,9 @@ def case_setup(
         value = float(round(magnitude)) if candidate.integer else float(magnitude)
         row[candidate.parameter] = value
         cfg = candidate_config(config, candidate, value)
+    row["seed"] = run_seed(config, case_id)
     if test == "shear_cell":
-        row.update(load_condition(config, case_id))
+        row.update(run_load(config, case_id))
     return row, cfg
 
 

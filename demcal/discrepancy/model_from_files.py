@@ -13,6 +13,7 @@ from demcal.core.provenance import write_sidecar
 from demcal.design.cases import design_spec
 from demcal.discrepancy.best_fit import ParameterBox
 from demcal.discrepancy.candidates import Candidate, base_point
+from demcal.discrepancy.dem_check import fitted_experiment
 from demcal.discrepancy.extension import rmse_of
 from demcal.discrepancy.find import FindResult, find
 from demcal.discrepancy.observations import LOAD_INPUTS, SurrogateModel, observation_table
@@ -165,7 +166,8 @@ def write_find(
     table_path, record_path, markdown_path : path
         Per-observation CSV, JSON record (:func:`find_record`) and markdown report to write.
     """
-    experiment = load_experiment(experiment_path)
+    # Held-out loads are kept for the DEM check of the Show step.
+    experiment = fitted_experiment(load_experiment(experiment_path), config)
     result, _, box = find_from_files(model_paths, experiment, config)
     record = find_record(result, box, config)
     result.observations.to_csv(table_path, index=False, float_format="%.8g")

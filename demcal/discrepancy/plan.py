@@ -25,6 +25,7 @@ from demcal.discrepancy.candidates import (
     probe_runs,
     run_suffixes,
 )
+from demcal.discrepancy.dem_check import fitted_experiment, held_out_suffixes, replicate_bases
 from demcal.discrepancy.observations import OBSERVABLES
 
 __all__ = ["VERIFICATION_CASE", "DiscrepancyPlan", "measured_observables"]
@@ -53,11 +54,15 @@ class DiscrepancyPlan:
         Virtual tests with measured observables.
     suffixes : list[str]
         Shear-cell case-id suffixes of one run (``_s<k>`` or ``_s<k>_p<j>``), the measured
-        load conditions among those of the design.
+        and fitted load conditions among those of the design.
     outputs : list[str]
         Measured observables (their surrogates are needed).
     candidates : list[Candidate]
         Applicable candidates (the current model lacks them).
+    held_out : list[str]
+        Suffixes ``_h<m>`` of the held-out conditions (DEM check only).
+    replicates : int
+        DEM runs per point and load in the DEM check.
     """
 
     root: str
@@ -65,11 +70,13 @@ class DiscrepancyPlan:
     suffixes: list[str]
     outputs: list[str]
     candidates: list[Candidate]
+    held_out: list[str]
+    replicates: int
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], results: str = "results") -> DiscrepancyPlan:
         """The plan of a validated configuration (reads its experiment file)."""
-        experiment = load_experiment(config["experiment"])
+        experiment = fitted_experiment(load_experiment(config["experiment"]), config)
         candidates = [
             c
             for c in parse_candidates(config["discrepancy"]["candidates"])
@@ -81,22 +88,29 @@ class DiscrepancyPlan:
             suffixes=run_suffixes(config, experiment),
             outputs=measured_observables(experiment),
             candidates=candidates,
+            held_out=held_out_suffixes(config),
+            replicates=int(config["discrepancy"]["replicates"]),
         )
 
-    def case_ids(self, bases: Sequence[str]) -> list[tuple[str, str]]:
-        """(test, case id) of runs ``bases`` in every measured test."""
+    def case_ids(self, bases: Sequence[str], held_out: bool = False) -> list[tuple[str, str]]:
+        """(test, case id) of runs ``bases`` in every measured test; with ``held_out`` the
+        shear cell also at the held-out loads (always measured there)."""
+        tests = self.tests
+        if held_out and self.held_out and "shear_cell" not in tests:
+            tests = ["shear_cell", *tests]
+        suffixes = self.suffixes + (self.held_out if held_out else [])
         ids = []
-        for test in self.tests:
+        for test in tests:
             for base in bases:
                 if test == "shear_cell":
-                    ids += [(test, f"{base}{suffix}") for suffix in self.suffixes]
+                    ids += [(test, f"{base}{suffix}") for suffix in suffixes]
                 else:
                     ids.append((test, base))
         return ids
 
-    def bulk_files(self, stage: str, bases: Sequence[str]) -> list[str]:
+    def bulk_files(self, stage: str, bases: Sequence[str], held_out: bool = False) -> list[str]:
         """``bulk.csv`` of runs ``bases`` under ``<root>/<stage>``."""
-        return [f"{self.root}/{stage}/{t}/{c}/bulk.csv" for t, c in self.case_ids(bases)]
+        return [f"{self.root}/{stage}/{t}/{c}/bulk.csv" for t, c in self.case_ids(bases, held_out)]
 
     @property
     def probe_cases(self) -> list[str]:
@@ -107,8 +121,12 @@ class DiscrepancyPlan:
         return self.bulk_files("probes", self.probe_cases) if missing(find_record) else []
 
     def reference_bulk(self, find_record: str | Path) -> list[str]:
-        """Bulk files of the reference probe run, or none when nothing is missing."""
-        return self.bulk_files("probes", [REFERENCE_CASE]) if missing(find_record) else []
+        """Bulk files of the replicates of the reference run at theta* (fitted and held-out
+        loads), or none when nothing is missing."""
+        if not missing(find_record):
+            return []
+        bases = replicate_bases(REFERENCE_CASE, self.replicates)
+        return self.bulk_files("probes", bases, held_out=True)
 
     def extended_bulk(self, design: str | Path) -> list[str]:
         """Bulk files of the extended design's runs (none when no effect was named)."""
@@ -116,10 +134,12 @@ class DiscrepancyPlan:
         return self.bulk_files("extended", list(table["case_id"])) if len(table) else []
 
     def verification_bulk(self, ranking_record: str | Path) -> list[str]:
-        """Bulk files of the verification runs, or none when no effect was named."""
-        return (
-            self.bulk_files("verification", [VERIFICATION_CASE]) if winner(ranking_record) else []
-        )
+        """Bulk files of the replicate verification runs (fitted and held-out loads), or none
+        when no effect was named."""
+        if not winner(ranking_record):
+            return []
+        bases = replicate_bases(VERIFICATION_CASE, self.replicates)
+        return self.bulk_files("verification", bases, held_out=True)
 
     def show_inputs(
         self, find_record: str | Path, ranking_record: str | Path

@@ -22,6 +22,7 @@ from demcal.discrepancy.candidates import (
     extended_design,
     parse_candidates,
 )
+from demcal.discrepancy.dem_check import fitted_experiment
 from demcal.discrepancy.effect_response import EffectResponse, response_signature
 from demcal.discrepancy.find import FindResult, find
 from demcal.discrepancy.model_from_files import (
@@ -331,7 +332,8 @@ def write_ranking(
         _empty(design_path, ["case_id"])
         _empty(probes_path, ["case_id"])
         return None
-    experiment = load_experiment(experiment_path)
+    # Held-out loads are kept for the DEM check of the Show step.
+    experiment = fitted_experiment(load_experiment(experiment_path), config)
     runs = read_runs(probe_files)
     runs.to_csv(probes_path, index=False, float_format="%.8g")
     result = rank(model_paths, experiment, config, runs, find_rec["point"])

@@ -12,6 +12,7 @@ from demcal.core.experiments import Experiment, load_experiment
 from demcal.core.provenance import write_sidecar
 from demcal.discrepancy.best_fit import ParameterBox
 from demcal.discrepancy.candidates import Candidate
+from demcal.discrepancy.dem_check import fitted_experiment
 from demcal.discrepancy.find import FindResult
 from demcal.discrepancy.model_from_files import (
     find_from_files,
@@ -131,7 +132,8 @@ def write_recalibration(
         The record written (see :func:`recalibrate`).
     """
     candidate = named_candidate(config, ranking_record_path)
-    experiment = load_experiment(experiment_path)
+    # Held-out loads are kept for the DEM check of the Show step.
+    experiment = fitted_experiment(load_experiment(experiment_path), config)
     result, box, record = recalibrate(model_paths, experiment, config, candidate)
     result.observations.to_csv(table_path, index=False, float_format="%.8g")
     Path(record_path).write_text(json.dumps(record, indent=2) + "\n")

@@ -17,8 +17,12 @@ import pandas as pd
 from demcal.discrepancy.find import FindResult
 from demcal.discrepancy.observations import format_stress
 
+#: DEM replicate statistics per observation: mean, sd and number of runs, shape (K,) each.
+Replicates = tuple[np.ndarray, np.ndarray, np.ndarray]
+
 __all__ = [
     "KEY_COLUMNS",
+    "Replicates",
     "condition_label",
     "find_markdown",
     "gap_figure",
@@ -159,28 +163,33 @@ def gap_of(z: pd.Series | np.ndarray) -> float:
 def gap_table(
     before: pd.DataFrame,
     after: pd.DataFrame | None,
-    dem_before: np.ndarray | None,
-    dem_after: np.ndarray | None,
+    dem_before: Replicates | None,
+    dem_after: Replicates | None,
 ) -> pd.DataFrame:
     """Per observation: misfit before and after the effect was added, surrogates and DEM.
 
     Parameters
     ----------
     before : DataFrame, shape (K, ...)
-        Find observations of the current model (measured, sigma, at_best, z_at_best).
+        Find observations of the current model (measured, sigma, at_best, z_at_best), and the
+        held-out observations (``held_out`` True, at_best NaN) after them.
     after : DataFrame or None
         Find observations of the extended model on the same observations.
-    dem_before, dem_after : ndarray, shape (K,), or None
-        DEM values at theta* (current model) and at the extended model's best point. Their z
-        uses the current model's sigma for both, so the two are directly comparable.
+    dem_before, dem_after : (mean, sd, n) of ndarray, shape (K,), or None
+        DEM replicate statistics at theta* (current model) and at the extended model's best
+        point (:func:`demcal.discrepancy.run_results.replicate_statistics`). Their z uses the
+        current model's sigma for both, so the two are directly comparable.
 
     Returns
     -------
-    DataFrame, shape (K, 15)
-        Also ``sigma_common`` (the larger sigma of the two models) and the misfits of both
-        models on it (``z_before_common``, ``z_after_common``).
+    DataFrame, shape (K, 20)
+        Also ``sigma_common`` (the larger sigma of the two models), the misfits of both
+        models on it (``z_before_common``, ``z_after_common``), the DEM means, their sd and
+        number of runs, and ``held_out``.
     """
     out = before[[*KEY_COLUMNS, "measured", "sigma"]].copy().reset_index(drop=True)
+    held = before["held_out"] if "held_out" in before else pd.Series(False, index=before.index)
+    out["held_out"] = held.fillna(False).astype(bool).to_numpy()
     out["model_before"] = before["at_best"].to_numpy(float)
     out["z_before"] = before["z_at_best"].to_numpy(float)
     if after is not None:
@@ -199,9 +208,14 @@ def gap_table(
     out["z_before_common"] = (out["model_before"] - out["measured"]) / common
     out["z_after_common"] = (out["model_after"] - out["measured"]) / common
     for label, values in (("before", dem_before), ("after", dem_after)):
-        vals = np.full(len(out), math.nan) if values is None else np.asarray(values, float)
-        out[f"dem_{label}"] = vals
-        out[f"z_dem_{label}"] = (vals - out["measured"]) / out["sigma"]
+        if values is None:
+            nan = np.full(len(out), math.nan)
+            values = (nan, nan, np.zeros(len(out), dtype=int))
+        mean, sd, count = (np.asarray(v) for v in values)
+        out[f"dem_{label}"] = mean.astype(float)
+        out[f"dem_{label}_sd"] = sd.astype(float)
+        out[f"dem_{label}_runs"] = count.astype(int)
+        out[f"z_dem_{label}"] = (out[f"dem_{label}"] - out["measured"]) / out["sigma"]
     return out
 
 
@@ -209,28 +223,62 @@ def _labels(table: pd.DataFrame) -> list[str]:
     labels = []
     for row in table.itertuples():
         if math.isfinite(row.normal_stress):
-            labels.append(f"{row.observable}\n{row.normal_stress:.0f} Pa, P={row.P:g}")
+            label = f"{row.observable}\n{row.normal_stress:.0f} Pa, P={row.P:g}"
         else:
-            labels.append(str(row.observable))
+            label = str(row.observable)
+        labels.append(f"{label}\n(held out)" if row.held_out else label)
     return labels
 
 
+def _gap_label(table: pd.DataFrame, column: str) -> str:
+    fitted = gap_of(table.loc[~table["held_out"], column])
+    text = f"gap {fitted:.2f}"
+    if table["held_out"].any():
+        text += f", held out {gap_of(table.loc[table['held_out'], column]):.2f}"
+    return text
+
+
 def gap_figure(table: pd.DataFrame, title: str, path: str | Path) -> None:
-    """|z| per observation before and after, surrogate and DEM panels, with the gap figures."""
+    """|z| per observation before and after: DEM replicate means with their scatter as error
+    bars (main panel) and the surrogate best fits (secondary panel).
+
+    Error bars are one replicate standard deviation of the DEM runs in units of sigma; the
+    held-out observations are labelled and shaded.
+    """
     x = np.arange(len(table))
     fig, axes = plt.subplots(
-        2, 1, figsize=(max(6.0, 0.55 * len(table) + 2.0), 6.5), sharex=True, constrained_layout=True
+        2,
+        1,
+        figsize=(max(6.0, 0.55 * len(table) + 2.0), 7.0),
+        sharex=True,
+        constrained_layout=True,
+        gridspec_kw={"height_ratios": [3, 2]},
     )
     panels = (
-        ("surrogate best fit (common sigma)", "z_before_common", "z_after_common"),
-        ("DEM verification", "z_dem_before", "z_dem_after"),
+        ("DEM runs (mean of replicates, error bar 1 sd)", "z_dem_before", "z_dem_after", "dem"),
+        ("surrogate best fit (common sigma), secondary", "z_before_common", "z_after_common", None),
     )
-    for ax, (name, zb, za) in zip(axes, panels, strict=True):
-        before = np.abs(table[zb].to_numpy(float))
-        after = np.abs(table[za].to_numpy(float))
-        ax.bar(x - 0.2, before, 0.4, label=f"before (gap {gap_of(table[zb]):.2f})", color="C3")
-        if np.isfinite(after).any():
-            ax.bar(x + 0.2, after, 0.4, label=f"after (gap {gap_of(table[za]):.2f})", color="C0")
+    sigma = table["sigma"].to_numpy(float)
+    for ax, (name, zb, za, dem) in zip(axes, panels, strict=True):
+        for j in np.flatnonzero(table["held_out"].to_numpy(bool)):
+            ax.axvspan(j - 0.5, j + 0.5, color="0.92", zorder=0)
+        for offset, column, label, color in ((-0.2, zb, "before", "C3"), (0.2, za, "after", "C0")):
+            values = np.abs(table[column].to_numpy(float))
+            if not np.isfinite(values).any():
+                continue
+            errors = None
+            if dem is not None:
+                errors = table[f"dem_{label}_sd"].to_numpy(float) / sigma
+                errors = np.where(np.isfinite(errors), errors, 0.0)
+            ax.bar(
+                x + offset,
+                values,
+                0.4,
+                yerr=errors,
+                capsize=2,
+                label=f"{label} ({_gap_label(table, column)})",
+                color=color,
+            )
         ax.axhline(1.0, color="0.5", lw=0.8, ls="--")
         ax.set_ylabel("|z| = |model - measured| / sigma")
         ax.set_title(name, fontsize=10)
@@ -241,40 +289,70 @@ def gap_figure(table: pd.DataFrame, title: str, path: str | Path) -> None:
     plt.close(fig)
 
 
+def _dem_cell(mean: float, sd: float, runs: int) -> str:
+    if not math.isfinite(mean):
+        return ""
+    spread = f" +- {sd:.3g}" if math.isfinite(sd) else ""
+    return f"{mean:.4g}{spread} ({runs})"
+
+
+def _dem_columns(table: pd.DataFrame, labels: Sequence[str]) -> pd.DataFrame:
+    shown = pd.DataFrame(
+        {
+            "observable": table["observable"],
+            "condition": [condition_label(r) for r in table.itertuples()],
+            "held out": np.where(table["held_out"], "yes", ""),
+            "measured": table["measured"],
+            "sigma": table["sigma"],
+        }
+    )
+    for label in labels:
+        shown[f"DEM {label} (runs)"] = [
+            _dem_cell(m, s, int(n))
+            for m, s, n in zip(
+                table[f"dem_{label}"],
+                table[f"dem_{label}_sd"],
+                table[f"dem_{label}_runs"],
+                strict=True,
+            )
+        ]
+        shown[f"z {label}"] = table[f"z_dem_{label}"]
+    return shown
+
+
 def verification_markdown(table: pd.DataFrame, summary: Mapping[str, Any]) -> str:
-    """DEM at the extended model's identified point against the measurements and theta*."""
+    """DEM replicates at the extended model's identified point against the measurements and
+    the current model at theta*, fitted and held-out loads apart."""
     lines = ["# Discrepancy - Show: verification DEM runs", ""]
     if not summary.get("extended"):
         lines += [f"No extended model: {summary.get('reason', '')}.", ""]
         if np.isfinite(table["dem_before"].to_numpy(float)).any():
-            lines += ["DEM at theta* of the current model:", ""]
-            shown = table[[*KEY_COLUMNS, "measured", "sigma", "dem_before", "z_dem_before"]]
-            lines.append(markdown_table(shown, ".4g"))
+            lines += ["DEM at theta* of the current model (mean +- sd of the replicates):", ""]
+            lines.append(markdown_table(_dem_columns(table, ["before"]), ".4g"))
         return "\n".join(lines) + "\n"
     params = ", ".join(f"{k} = {v:.4g}" for k, v in summary["identified"].items())
     lines += [
         f"Effect added: {summary['winner']} ({summary['parameter']}); identified point of the "
         f"extended model: {params}.",
         "",
+        f"DEM gap on the fitted loads, mean of {summary['replicates']} runs from fresh packings: "
+        f"{summary['dem_gap_before']:.3f} before (current model at theta*), "
+        f"{summary['dem_gap_after']:.3f} after (extended model at its identified point); z "
+        "uses the current model's sigma in both.",
+        "",
+    ]
+    if summary.get("held_out"):
+        lines += [
+            f"Held-out loads ({', '.join(summary['held_out'])}; never seen by Find, naming or "
+            f"the recalibration): DEM gap {summary['held_out_dem_gap_before']:.3f} before, "
+            f"{summary['held_out_dem_gap_after']:.3f} after.",
+            "",
+        ]
+    lines += [
         f"Surrogate gap on a common sigma (the larger of both models'): "
         f"{summary['gap_before_common']:.3f} before, {summary['gap_after']:.3f} after "
         f"({summary['gap_ratio']:.1f} x smaller).",
         "",
-        f"DEM gap before (current model at theta*): {summary['dem_gap_before']:.3f}; after "
-        f"(extended model at its identified point): {summary['dem_gap_after']:.3f}; z uses the "
-        "current model's sigma in both.",
-        "",
+        markdown_table(_dem_columns(table, ["before", "after"]), ".4g"),
     ]
-    shown = table[
-        [
-            *KEY_COLUMNS,
-            "measured",
-            "sigma",
-            "dem_before",
-            "z_dem_before",
-            "dem_after",
-            "z_dem_after",
-        ]
-    ]
-    lines.append(markdown_table(shown, ".4g"))
     return "\n".join(lines) + "\n"

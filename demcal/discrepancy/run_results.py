@@ -1,18 +1,18 @@
-"""Results of the discrepancy runs: bulk rows with their case parameters, and the DEM values
-of the observations in one run."""
+"""Results of the discrepancy runs: bulk rows with their case parameters, the DEM values of
+the observations in one run and their statistics over replicate runs."""
 
 from __future__ import annotations
 
 import json
 import math
 import numbers
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-__all__ = ["read_runs", "run_values"]
+__all__ = ["read_runs", "replicate_statistics", "run_values"]
 
 _TEST_NAMES = {"repose": "angle_of_repose"}
 
@@ -51,6 +51,11 @@ def read_runs(bulk_files: Iterable[str | Path]) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True, sort=False)
 
 
+def _run_base(runs: pd.DataFrame) -> pd.Series:
+    """Run id of every row without its load suffix (``_s<i>[_p<j>]`` or ``_h<m>``)."""
+    return runs["run"].astype(str).str.replace(r"(_s\d+(_p\d+)?|_h\d+)$", "", regex=True)
+
+
 def run_values(runs: pd.DataFrame, run: str, observations: pd.DataFrame) -> np.ndarray:
     """DEM values of the observations in one run (all its tests), NaN where missing or failed.
 
@@ -59,8 +64,8 @@ def run_values(runs: pd.DataFrame, run: str, observations: pd.DataFrame) -> np.n
     runs : DataFrame
         Rows of :func:`read_runs` (column ``run`` = case dir).
     run : str
-        Run id without the stress suffix (e.g. ``ref`` for ``ref_s1``, ``ref_s2`` and the
-        angle-of-repose case ``ref``).
+        Run id without the load suffix (e.g. ``ref`` for ``ref_s1``, ``ref_s2``, ``ref_h1``
+        and the angle-of-repose case ``ref``).
     observations : DataFrame, shape (K, ...)
 
     Returns
@@ -69,8 +74,7 @@ def run_values(runs: pd.DataFrame, run: str, observations: pd.DataFrame) -> np.n
     """
     if len(runs) == 0:
         return np.full(len(observations), math.nan)
-    base = runs["run"].astype(str).str.replace(r"_s\d+(_p\d+)?$", "", regex=True)
-    mine = runs[(base == run) & (runs["status"] == "ok")]
+    mine = runs[(_run_base(runs) == run) & (runs["status"] == "ok")]
     out = np.full(len(observations), math.nan)
     for k, (_, row) in enumerate(observations.iterrows()):
         name = row["observable"]
@@ -85,3 +89,33 @@ def run_values(runs: pd.DataFrame, run: str, observations: pd.DataFrame) -> np.n
         if len(match) and name in match and np.isfinite(float(match[name].iloc[0])):
             out[k] = float(match[name].iloc[0])
     return out
+
+
+def replicate_statistics(
+    runs: pd.DataFrame, bases: Sequence[str], observations: pd.DataFrame
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean, sample standard deviation and count of the observations over replicate runs.
+
+    Parameters
+    ----------
+    runs : DataFrame
+        Rows of :func:`read_runs`.
+    bases : sequence of str
+        Run ids of the replicates without load suffix (``ref``, ``ref_r2``, ...).
+    observations : DataFrame, shape (K, ...)
+
+    Returns
+    -------
+    mean, sd, n : ndarray, shape (K,)
+        Over the replicates that finished; sd is NaN below two, mean NaN for none.
+    """
+    values = np.array([run_values(runs, base, observations) for base in bases]).reshape(
+        len(bases), len(observations)
+    )
+    finite = np.isfinite(values)
+    n = finite.sum(axis=0)
+    total = np.where(finite, values, 0.0).sum(axis=0)
+    mean = np.divide(total, n, out=np.full(len(observations), math.nan), where=n > 0)
+    squares = np.where(finite, (values - mean) ** 2, 0.0).sum(axis=0)
+    sd = np.sqrt(np.divide(squares, n - 1, out=np.full(len(observations), math.nan), where=n > 1))
+    return mean, sd, n

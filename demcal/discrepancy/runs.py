@@ -18,6 +18,7 @@ from demcal.discrepancy.candidates import (
     case_setup,
     parse_candidates,
 )
+from demcal.discrepancy.dem_check import parse_run_id
 from demcal.virtual_tests.deck import render_case
 
 __all__ = ["candidate_by_name", "discrepancy_case", "named_candidate", "render_discrepancy_run"]
@@ -60,7 +61,8 @@ def discrepancy_case(
         extended: a row of the extended design (``record`` = ranking record, ``design``);
         verification: the extended model's best point (``record`` = recalibration record).
     test, case : str
-        Test and case id (``<run>_s<k>[_p<j>]`` for the shear cell).
+        Test and case id (``<run>[_r<k>]``, with ``_s<i>[_p<j>]`` or ``_h<m>`` for the shear
+        cell; :func:`demcal.discrepancy.dem_check.parse_run_id`).
     config : mapping
         The validated configuration of the current model.
 
@@ -69,7 +71,7 @@ def discrepancy_case(
     KeyError
         For a case id that belongs to no run of the mode.
     """
-    run = case.split("_s")[0] if test == "shear_cell" else case
+    run = parse_run_id(case).run
     if mode == "probe":
         point = dict(record["point"])
         if run == REFERENCE_CASE:

@@ -30,8 +30,9 @@ import yaml
 
 from demcal.bulk.synthetic import run_case_bulk
 from demcal.core.config import validate_config
-from demcal.design.cases import load_condition, shear_suffixes
+from demcal.design.cases import shear_suffixes
 from demcal.discrepancy.candidates import deep_merge
+from demcal.discrepancy.dem_check import held_out_suffixes, run_load
 from demcal.discrepancy.truths import DrawnTruth, draw_truth, load_truth_spec, truth_config
 
 __all__ = [
@@ -73,6 +74,8 @@ _PROFILES: dict[str, dict[str, Any]] = {
             },
         },
         "shear_cell": {"normal_stresses": [1068.0, 2029.0], "P": [0.5]},
+        # Measured but left out of the fit: the DEM check of the result at a load no step saw.
+        "discrepancy": {"held_out": [{"normal_stress": 1500.0, "P": 0.5}]},
         # The angle of repose is not measured in the study; its design runs are kept short.
         "angle_of_repose": {"dCylDp": 6, "lift_time": 0.5, "final_settle_fall_times": 1.0},
         "surrogate": {"hidden_sizes": [3, 6], "max_epochs": 300, "patience": 20},
@@ -86,6 +89,7 @@ _PROFILES: dict[str, dict[str, Any]] = {
             "fixed": {"coefficientRollingFriction": 0.0, "coefficientRestitution": 0.7},
         },
         "shear_cell": {"normal_stresses": [1068.0, 2029.0, 10070.0], "P": [0.5]},
+        "discrepancy": {"held_out": [{"normal_stress": 5000.0, "P": 0.5}]},
     },
 }
 
@@ -208,7 +212,8 @@ def hidden_effect_bulk(
         Where the runs are made.
     tests : sequence of str
         Virtual tests to run; the shear-cell runs are those of a design row
-        (:func:`demcal.design.cases.shear_suffixes`).
+        (:func:`demcal.design.cases.shear_suffixes`) and the held-out loads
+        (``discrepancy.held_out``).
     workers : int
         Runs at the same time.
     replicates : int
@@ -232,9 +237,9 @@ def hidden_effect_bulk(
         if "angle_of_repose" in tests:
             cases.append(("angle_of_repose", {"case_id": f"truth{r}", **params}, r))
         if "shear_cell" in tests:
-            for suffix in shear_suffixes(cfg):
+            for suffix in shear_suffixes(cfg) + held_out_suffixes(cfg):
                 key = f"truth{r}{suffix}"
-                row = {"case_id": key, **params, **load_condition(cfg, key)}
+                row = {"case_id": key, **params, **run_load(cfg, key)}
                 cases.append(("shear_cell", row, r))
 
     def run(item: tuple[str, dict[str, Any], int]) -> pd.DataFrame:

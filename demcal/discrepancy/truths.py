@@ -13,7 +13,9 @@ are found:
 - ``probe_clearance``: a drawn magnitude closer than this fraction of the range to a probe level
   is drawn again (default :data:`PROBE_CLEARANCE`), so no truth sits at a level the workflow
   measures directly;
-- ``profiles``: per profile, replacements of ``parameters`` and ``draw``.
+- ``switch``: configuration overrides of the truth runs beyond the hidden candidate (an
+  effect outside the catalogue, e.g. softer particles);
+- ``profiles``: per profile, replacements of ``parameters``, ``draw`` and ``switch``.
 
 The effect is switched on with the candidate's own switch and configuration key, so the truth
 runs use exactly the deck switch the workflow would add. The drawn truth is written next to the
@@ -114,7 +116,7 @@ def load_truth_spec(path: str | Path) -> dict[str, Any]:
 def _profile_spec(spec: Mapping[str, Any], profile: str) -> dict[str, Any]:
     overrides = (spec.get("profiles") or {}).get(profile) or {}
     out = dict(spec)
-    for key in ("parameters", "draw", "effect_span", "probe_clearance"):
+    for key in ("parameters", "draw", "switch", "effect_span", "probe_clearance"):
         if key in overrides:
             out[key] = (
                 {**(spec.get(key) or {}), **overrides[key]}

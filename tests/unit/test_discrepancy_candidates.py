@@ -144,12 +144,15 @@ def test_probe_runs_and_plan_file_lists(study, tmp_path):
     cands = [c for c in parse_candidates(study["discrepancy"]["candidates"])]
     runs = probe_runs(cands[:2])
     assert [r.case for r in runs][:3] == ["ref", "cohesion1", "cohesion2"]
-    plan = DiscrepancyPlan("results/discrepancy", ["shear_cell"], ["_s1", "_s2"], [], cands[:1])
+    plan = DiscrepancyPlan(
+        "results/discrepancy", ["shear_cell"], ["_s1", "_s2"], [], cands[:1], ["_h1"], 2
+    )
     assert plan.case_ids(["ref"]) == [("shear_cell", "ref_s1"), ("shear_cell", "ref_s2")]
     find = tmp_path / "find.json"
     find.write_text('{"missing": false}')
     assert plan.probe_bulk(find) == []
     find.write_text('{"missing": true}')
+    # Probe runs only at the fitted loads, one run each: they feed the naming.
     assert plan.probe_bulk(find) == [
         f"results/discrepancy/probes/shear_cell/{c}_s{k}/bulk.csv"
         for c in ("ref", "cohesion1", "cohesion2", "cohesion3")
@@ -157,7 +160,15 @@ def test_probe_runs_and_plan_file_lists(study, tmp_path):
     ]
     ranking = tmp_path / "ranking.json"
     ranking.write_text('{"winner": null}')
-    assert plan.show_inputs(find, ranking) == {"reference": plan.bulk_files("probes", ["ref"])}
+    # The DEM check: every replicate of the reference, at the fitted and the held-out loads.
+    reference = [
+        f"results/discrepancy/probes/shear_cell/{r}{k}/bulk.csv"
+        for r in ("ref", "ref_r2")
+        for k in ("_s1", "_s2", "_h1")
+    ]
+    assert plan.show_inputs(find, ranking) == {"reference": reference}
     ranking.write_text('{"winner": "cohesion"}')
     inputs = plan.show_inputs(find, ranking)
-    assert inputs["verification"] == plan.bulk_files("verification", ["verify"])
+    assert inputs["verification"] == [
+        f.replace("probes", "verification").replace("ref", "verify") for f in reference
+    ]

@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pandas as pd
 import pytest
+from matplotlib.container import BarContainer
 
 from demcal.discrepancy.candidates import Candidate
 from demcal.discrepancy.extension import (
@@ -14,7 +15,7 @@ from demcal.discrepancy.extension import (
     train_extended_surrogate,
 )
 from demcal.discrepancy.report import gap_figure, gap_of, gap_table, markdown_table
-from demcal.discrepancy.run_results import read_runs, run_values
+from demcal.discrepancy.run_results import read_runs, replicate_statistics, run_values
 from demcal.discrepancy.synthetic import replicate_record
 from demcal.surrogates.training import load_surrogate
 from tests.figures import read_png, saved_figures
@@ -142,49 +143,86 @@ def test_extended_surrogate_learns_the_new_input(tmp_path):
 
 
 def test_gap_table_and_figure(tmp_path):
+    # Two fitted observations and one at a held-out load (no surrogate value there).
     before = pd.DataFrame(
         {
-            "observable": ["mu_psh", "rho_b"],
-            "normal_stress": [1068.0, 1068.0],
-            "P": [1.0, 1.0],
-            "measured": [0.7, 1700.0],
-            "sigma": [0.1, 10.0],
-            "at_best": [0.5, 1660.0],
-            "z_at_best": [-2.0, -4.0],
+            "observable": ["mu_psh", "rho_b", "mu_psh"],
+            "normal_stress": [1068.0, 1068.0, 1500.0],
+            "P": [1.0, 1.0, 0.5],
+            "measured": [0.7, 1700.0, 0.65],
+            "sigma": [0.1, 10.0, 0.05],
+            "at_best": [0.5, 1660.0, math.nan],
+            "z_at_best": [-2.0, -4.0, math.nan],
+            "held_out": [False, False, True],
         }
     )
-    after = before.assign(at_best=[0.68, 1705.0], z_at_best=[-0.2, 0.5], sigma=[0.1, 12.0])
-    table = gap_table(before, after, np.array([0.45, 1650.0]), np.array([0.72, 1710.0]))
-    assert table["z_dem_before"].to_numpy() == pytest.approx([-2.5, -5.0])
-    assert table["z_dem_after"].to_numpy() == pytest.approx([0.2, 1.0])
+    after = before.iloc[:2].assign(at_best=[0.68, 1705.0], z_at_best=[-0.2, 0.5], sigma=[0.1, 12.0])
+    dem_before = (np.array([0.45, 1650.0, 0.55]), np.array([0.02, 5.0, 0.01]), np.array([3, 3, 3]))
+    dem_after = (
+        np.array([0.72, 1710.0, 0.66]),
+        np.array([0.03, 4.0, math.nan]),
+        np.array([3, 3, 1]),
+    )
+    table = gap_table(before, after, dem_before, dem_after)
+    assert table["z_dem_before"].to_numpy() == pytest.approx([-2.5, -5.0, -2.0])
+    assert table["z_dem_after"].to_numpy() == pytest.approx([0.2, 1.0, 0.2])
+    assert list(table["held_out"]) == [False, False, True]
+    assert list(table["dem_after_runs"]) == [3, 3, 1]
     assert gap_of(table["z_before"]) == pytest.approx(math.sqrt(10.0))
     assert math.isnan(gap_of([math.nan]))  # nothing is finite
     with saved_figures() as figures:
         gap_figure(table, "test", tmp_path / "gap.png")
-    ((surrogate, dem),) = [f.axes for f in figures]
+    ((dem, surrogate),) = [f.axes for f in figures]
     assert figures[0].get_suptitle() == "test"
-    # |z| bars, before (left of each tick) and after (right), on the common sigma: 0.1 for
-    # mu_psh, the after model's 12 kg/m^3 for rho_b; the DEM panel on the current sigma.
-    expected = {
-        surrogate: ([2.0, 40.0 / 12.0], [0.2, 5.0 / 12.0], "z_before_common", "z_after_common"),
-        dem: ([2.5, 5.0], [0.2, 1.0], "z_dem_before", "z_dem_after"),
-    }
-    for ax, (before_z, after_z, before_col, after_col) in expected.items():
-        bars = ax.patches
-        assert [b.get_x() + 0.5 * b.get_width() for b in bars] == pytest.approx(
-            [-0.2, 0.8, 0.2, 1.2]
-        )
-        assert [b.get_height() for b in bars] == pytest.approx([*before_z, *after_z])
-        legend = [t.get_text() for t in ax.get_legend().get_texts()]
-        assert legend == [
-            f"before (gap {gap_of(table[before_col]):.2f})",
-            f"after (gap {gap_of(table[after_col]):.2f})",
-        ]
-    labels = [t.get_text() for t in dem.get_xticklabels()]
-    assert labels == ["mu_psh\n1068 Pa, P=1", "rho_b\n1068 Pa, P=1"]
-    assert read_png(tmp_path / "gap.png").shape == (780, 720, 3)  # 6 x 6.5 in at 120 dpi
+    # DEM panel first: |z| of the replicate means on the current sigma, error bars one
+    # replicate sd in sigma units (none where a single run finished).
+    bars = [b for b in dem.patches if b.get_width() == pytest.approx(0.4)]
+    assert [b.get_x() + 0.2 for b in bars] == pytest.approx([-0.2, 0.8, 1.8, 0.2, 1.2, 2.2])
+    assert [b.get_height() for b in bars] == pytest.approx([2.5, 5.0, 2.0, 0.2, 1.0, 0.2])
+    errors = [c for c in dem.containers if isinstance(c, BarContainer) and c.errorbar]
+    segments = [seg for c in errors for seg in c.errorbar.lines[2][0].get_segments()]
+    lengths = [seg[1][1] - seg[0][1] for seg in segments]
+    assert lengths == pytest.approx([0.4, 1.0, 0.4, 0.6, 0.8, 0.0])
+    legend = [t.get_text() for t in dem.get_legend().get_texts()]
+    fitted = table[~table["held_out"]]
+    assert legend == [
+        f"before (gap {gap_of(fitted['z_dem_before']):.2f}, held out 2.00)",
+        f"after (gap {gap_of(fitted['z_dem_after']):.2f}, held out 0.20)",
+    ]
+    # Surrogate panel: the common sigma (0.1 for mu_psh, the after model's 12 kg/m^3 for
+    # rho_b); nothing at the held-out load.
+    heights = [b.get_height() for b in surrogate.patches if b.get_width() == pytest.approx(0.4)]
+    assert heights[:2] == pytest.approx([2.0, 40.0 / 12.0])
+    assert heights[3:5] == pytest.approx([0.2, 5.0 / 12.0])
+    labels = [t.get_text() for t in surrogate.get_xticklabels()]
+    assert labels == [
+        "mu_psh\n1068 Pa, P=1",
+        "rho_b\n1068 Pa, P=1",
+        "mu_psh\n1500 Pa, P=0.5\n(held out)",
+    ]
+    assert read_png(tmp_path / "gap.png").shape == (840, 720, 3)  # 6 x 7 in at 120 dpi
     text = markdown_table(table[["observable", "z_before"]])
     assert text.splitlines()[2] == "| mu_psh | -2 |"
+
+
+def test_replicate_statistics_over_seeds():
+    obs = pd.DataFrame({"observable": ["mu_psh"], "normal_stress": [1068.0], "P": [0.5]})
+    runs = pd.DataFrame(
+        {
+            "test": "shear_cell",
+            "run": ["ref_s1", "ref_r2_s1", "ref_r3_s1", "ref_r4_s1", "ref_h1"],
+            "normal_stress": [1068.0, 1068.0, 1068.0, 1068.0, 1500.0],
+            "P": 0.5,
+            "mu_psh": [0.60, 0.64, 0.68, 0.99, 0.5],
+            "status": ["ok", "ok", "ok", "failed", "ok"],
+        }
+    )
+    mean, sd, n = replicate_statistics(runs, ["ref", "ref_r2", "ref_r3", "ref_r4"], obs)
+    assert mean == pytest.approx([0.64])
+    assert sd == pytest.approx([0.04])
+    assert list(n) == [3]
+    mean, sd, n = replicate_statistics(runs, ["ref"], obs)
+    assert mean == pytest.approx([0.60]) and math.isnan(sd[0]) and list(n) == [1]
 
 
 def test_replicate_record_states_mean_and_scatter():

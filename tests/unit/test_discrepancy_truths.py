@@ -129,9 +129,17 @@ def test_shipped_truth_specifications_draw_on_both_profiles() -> None:
         config = yaml.safe_load((ROOT / "config" / f"{name}.yaml").read_text())
         if name == "config":
             config["profile"] = "quick"
+        names = {c["name"] for c in config["discrepancy"]["candidates"]}
         for path in sorted(TRUTHS.glob("hidden_*.yaml")):
+            effect = yaml.safe_load(path.read_text())["effect"]
+            if effect is not None and effect not in names:
+                # Wall friction is a candidate of the quick catalogue only.
+                assert name == "tiny", (name, effect)
+                with pytest.raises(ValueError, match=f"{path}: effect '{effect}' is not a"):
+                    draw_truth(load_truth_spec(path), config, 1, str(path))
+                continue
             truth = draw_truth(load_truth_spec(path), config, 1, str(path))
-            assert truth.effect == yaml.safe_load(path.read_text())["effect"], path
+            assert truth.effect == effect, path
             if truth.magnitude is not None:
                 levels = next(
                     c["probe_levels"]
@@ -141,3 +149,19 @@ def test_shipped_truth_specifications_draw_on_both_profiles() -> None:
                 assert len(levels) >= 3, (name, truth.effect)
                 assert truth.magnitude not in levels
     assert MAX_EFFECT_FRACTION <= 0.8
+
+
+def test_an_outside_effect_switches_the_configuration_per_profile() -> None:
+    spec = load_truth_spec(TRUTHS / "hidden_softer.yaml")
+    tiny = yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text())
+    quick = {**yaml.safe_load((ROOT / "config" / "config.yaml").read_text()), "profile": "quick"}
+    for config, softer in ((tiny, 250.0), (quick, 750.0)):
+        truth = draw_truth(spec, config, 3)
+        assert truth.effect is None and truth.magnitude is None
+        runs = truth_config(truth, config)
+        stiff = config["shear_cell"]["youngs_modulus_per_stress"]
+        assert runs["shear_cell"]["youngs_modulus_per_stress"] == softer < stiff / 3
+        # Only the stiffness changes in the shear cell.
+        assert {
+            k: v for k, v in runs["shear_cell"].items() if k != "youngs_modulus_per_stress"
+        } == {k: v for k, v in config["shear_cell"].items() if k != "youngs_modulus_per_stress"}

@@ -1,6 +1,7 @@
 # Discrepancy workflow: find where the calibrated model and the measurements disagree, name the
-# missing physical effect with DEM probe runs around the best point (BIC ranking), add it to the
-# model (extended design, new surrogates, recalibration) and show the gap before and after.
+# missing physical effect with DEM probe runs around the best point (bootstrap tests), add it to
+# the model (extended design, new surrogates, recalibration) and show the gap before and after
+# with replicate DEM runs, also at held-out loads that no step before saw.
 # Target: `snakemake --cores 2 discrepancy`. If nothing is missing it stops after Find.
 
 from demcal.discrepancy.plan import DiscrepancyPlan
@@ -209,6 +210,7 @@ rule discrepancy_show:
         find=f"{DISC}/find.json",
         find_table=f"{DISC}/find.csv",
         ranking=f"{DISC}/ranking.json",
+        experiment=config["experiment"],
     output:
         table=report(
             f"{DISC}/gap_before_after.csv",

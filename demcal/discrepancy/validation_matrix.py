@@ -1,0 +1,380 @@
+"""The validation matrix of the discrepancy workflow: hidden effects x drawn truths.
+
+Every row of the matrix is one blind study: a truth specification (a hidden catalogue effect,
+nothing, or an effect outside the catalogue such as softer particles) and a seed from which the
+truth is drawn (:mod:`demcal.discrepancy.truths`); its measurements come from the truth engine
+(LIGGGHTS by default) with replicate runs and noise (:mod:`demcal.discrepancy.synthetic`), and
+``snakemake discrepancy`` runs on it as a user would. The current model (design runs and
+surrogates) does not depend on the truth, so it is made once in a base directory and copied into
+every study.
+
+The outcome of a study is what the workflow said: ``nothing missing``, the named candidate, or
+``not explained`` (something is missing but no candidate was named). The summary is a confusion
+matrix of hidden effect against outcome, with the naming accuracy over the catalogue rows, the
+false-alarm rate on the rows with nothing hidden, and for the outside effect whether the gap
+after a named proxy stays above the noise.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import shutil
+import subprocess
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+import yaml
+
+from demcal.core.config import validate_config
+from demcal.discrepancy.report import markdown_table
+from demcal.discrepancy.synthetic import study_config, write_hidden_effect_experiment
+from demcal.discrepancy.truths import load_truth_spec
+
+__all__ = [
+    "NOTHING",
+    "NOT_EXPLAINED",
+    "MatrixCase",
+    "confusion_matrix",
+    "matrix_cases",
+    "matrix_markdown",
+    "matrix_scores",
+    "placeholder_experiment",
+    "prepare_base",
+    "run_case",
+    "study_outcome",
+]
+
+#: Outcome when Find sees no gap.
+NOTHING = "nothing missing"
+#: Outcome when something is missing but no candidate is named.
+NOT_EXPLAINED = "not explained"
+#: Experiment file of a study, relative to its directory.
+EXPERIMENT = "config/experiments/measured.yaml"
+#: Largest surrogate gap after a proxy that still counts as explained (|z| ~ 1 is noise).
+NOISE_GAP = 1.5
+
+
+@dataclass(frozen=True)
+class MatrixCase:
+    """One study of the matrix.
+
+    Attributes
+    ----------
+    label : str
+        Row label: the spec file's name without ``hidden_`` (``cohesion``, ``none``, ...).
+    spec : Path
+        Truth specification.
+    kind : {"catalogue", "nothing", "outside"}
+        A catalogue effect, nothing hidden, or a configuration change outside the catalogue.
+    hidden : str
+        The candidate name for a catalogue effect, else the label.
+    truth_seed : int
+        Seed of the truth draw (and of the noise).
+    """
+
+    label: str
+    spec: Path
+    kind: str
+    hidden: str
+    truth_seed: int
+
+    @property
+    def name(self) -> str:
+        """Directory name of the study."""
+        return f"{self.label}_{self.truth_seed}"
+
+
+def matrix_cases(specs: Sequence[str | Path], truths: int, first_seed: int) -> list[MatrixCase]:
+    """The studies of a matrix: every specification with ``truths`` seeds from ``first_seed``,
+    ordered seed by seed.
+
+    Raises
+    ------
+    ValueError
+        For fewer than one truth per specification.
+    """
+    if truths < 1:
+        raise ValueError(f"truths per hidden effect must be >= 1, got {truths}")
+    kinds = []
+    for path in specs:
+        path = Path(path)
+        spec = load_truth_spec(path)
+        label = path.stem.removeprefix("hidden_")
+        if spec.get("effect") is not None:
+            kinds.append((label, path, "catalogue", str(spec["effect"])))
+        elif spec.get("switch"):
+            kinds.append((label, path, "outside", label))
+        else:
+            kinds.append((label, path, "nothing", label))
+    # Seed by seed, so that a matrix stopped early still covers every row.
+    return [
+        MatrixCase(label, path, kind, hidden, first_seed + k)
+        for k in range(int(truths))
+        for label, path, kind, hidden in kinds
+    ]
+
+
+def _snakemake(work: Path, cores: int, log: Path, *targets: str) -> None:
+    root = Path(__file__).resolve().parents[2]
+    cmd = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        *targets,
+        "--snakefile",
+        str(root / "Snakefile"),
+        "--directory",
+        str(work),
+        "--configfile",
+        str(work / "config" / "config.yaml"),
+        "--cores",
+        str(cores),
+        # Rendering and bulk-value jobs in threads, not a new interpreter each.
+        "--force-use-threads",
+        # A study stopped part-way is resumed.
+        "--rerun-incomplete",
+    ]
+    with log.open("w") as handle:
+        res = subprocess.run(cmd, cwd=work, stdout=handle, stderr=subprocess.STDOUT, check=False)
+    if res.returncode != 0:
+        tail = "\n".join(log.read_text().splitlines()[-40:])
+        raise RuntimeError(f"snakemake {' '.join(targets)} in {work} failed ({log}):\n{tail}")
+
+
+def placeholder_experiment(config: Mapping[str, Any]) -> dict[str, Any]:
+    """An experiment-file mapping with every load of the study and round values.
+
+    The workflow reads the experiment file when it is parsed, so the base directory needs
+    one before any truth has run; the design runs and surrogates do not depend on it.
+    """
+    cell = config["shear_cell"]
+    loads = [(float(s), float(p)) for s in cell["normal_stresses"] for p in cell["P"]]
+    loads += [(float(h["normal_stress"]), float(h["P"])) for h in config["discrepancy"]["held_out"]]
+    return {
+        "material": "placeholder (replaced by each study's truth)",
+        "source": "none",
+        "shear_cell": [
+            {"normal_stress": s, "P": p, "mu_psh": 0.6, "mu_sh": 0.5, "rho_b": 1500.0}
+            for s, p in loads
+        ],
+    }
+
+
+def prepare_base(profile_config: str | Path, base_dir: str | Path, cores: int = 2) -> Path:
+    """Make the current model once: the study configuration, its design runs and surrogates.
+
+    Parameters
+    ----------
+    profile_config : path
+        Configuration of the scale (``config/tiny.yaml``, ``config/config.yaml``).
+    base_dir : path
+        Directory to create (resumable: Snakemake keeps what is done).
+    cores : int
+        Cores for Snakemake.
+
+    Returns
+    -------
+    Path
+        The base directory.
+    """
+    base = Path(base_dir)
+    (base / "config" / "experiments").mkdir(parents=True, exist_ok=True)
+    raw = yaml.safe_load(Path(profile_config).read_text()) or {}
+    config = study_config(raw)
+    config["experiment"] = EXPERIMENT
+    path = base / "config" / "config.yaml"
+    path.write_text(yaml.safe_dump(config, sort_keys=False))
+    validated = validate_config(copy.deepcopy(config), str(path))
+    if not (base / EXPERIMENT).is_file():
+        placeholder = placeholder_experiment(validated)
+        (base / EXPERIMENT).write_text(yaml.safe_dump(placeholder, sort_keys=False))
+    outputs = ("mu_psh", "mu_sh", "rho_b")
+    targets = [f"results/surrogates/{o}/model.pt" for o in outputs]
+    _snakemake(base, cores, base / "base.log", *targets)
+    return base
+
+
+def run_case(
+    case: MatrixCase,
+    base_dir: str | Path,
+    out_dir: str | Path,
+    truth_engine: str | None,
+    noise: Mapping[str, float] | None = None,
+    replicates: int = 3,
+    cores: int = 2,
+) -> dict[str, Any]:
+    """Run one blind study (resumable) and return its row of the matrix.
+
+    The base directory is copied into ``out_dir/<case.name>``; the truth is drawn, run on
+    ``truth_engine`` and written as the study's experiment (kept when it exists); then
+    ``snakemake discrepancy`` runs.
+    """
+    work = Path(out_dir) / case.name
+    if not (work / "config" / "config.yaml").is_file():
+        shutil.copytree(base_dir, work, dirs_exist_ok=True, symlinks=True)
+    if not (work / "truth.yaml").is_file():
+        raw = yaml.safe_load((work / "config" / "config.yaml").read_text())
+        validated = validate_config(raw, str(work / "config" / "config.yaml"))
+        _, truth = write_hidden_effect_experiment(
+            case.spec,
+            validated,
+            work / EXPERIMENT,
+            work / "truth_runs",
+            noise,
+            case.truth_seed,
+            workers=cores,
+            replicates=replicates,
+            truth_seed=case.truth_seed,
+            truth_engine=truth_engine,
+        )
+        shutil.rmtree(work / "truth_runs")
+        (work / "truth.yaml").write_text(yaml.safe_dump(truth.record(), sort_keys=False))
+    _snakemake(work, cores, work / "discrepancy.log", "discrepancy")
+    return study_outcome(case, work)
+
+
+def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
+    """The matrix row of a finished study: truth, outcome, gaps and the magnitude found."""
+    work = Path(work)
+    out = work / "results" / "discrepancy"
+    summary = json.loads((out / "summary.json").read_text())
+    truth = yaml.safe_load((work / "truth.yaml").read_text())
+    ranking = json.loads((out / "ranking.json").read_text())
+    if not summary["missing"]:
+        outcome = NOTHING
+    else:
+        outcome = summary.get("winner") or NOT_EXPLAINED
+    magnitude = summary.get("magnitude")
+    truth_magnitude = truth.get("magnitude")
+    ratio = math.nan
+    if outcome == case.hidden and magnitude is not None and truth_magnitude:
+        ratio = float(magnitude) / float(truth_magnitude)
+    nan = math.nan
+    return {
+        "hidden": case.label,
+        "kind": case.kind,
+        "truth_seed": case.truth_seed,
+        "truth_friction": truth["parameters"].get("coefficientFriction", nan),
+        "truth_magnitude": truth_magnitude if truth_magnitude is not None else nan,
+        "outcome": outcome,
+        "correct": _correct(case, outcome, summary),
+        "p_find": summary["p_value"],
+        "p_effect": ranking.get("p_effect", nan) if ranking.get("ran", True) else nan,
+        "p_runner_up": ranking.get("p_runner_up", nan) if ranking.get("ran", True) else nan,
+        "gap_before": summary["gap_before"],
+        "gap_after": summary.get("gap_after", nan),
+        "dem_gap_before": summary.get("dem_gap_before", nan),
+        "dem_gap_after": summary.get("dem_gap_after", nan),
+        "held_out_dem_gap_before": summary.get("held_out_dem_gap_before", nan),
+        "held_out_dem_gap_after": summary.get("held_out_dem_gap_after", nan),
+        "magnitude": magnitude if magnitude is not None else nan,
+        "magnitude_ratio": ratio,
+    }
+
+
+def _correct(case: MatrixCase, outcome: str, summary: Mapping[str, Any]) -> bool:
+    if case.kind == "catalogue":
+        return outcome == case.hidden
+    if case.kind == "nothing":
+        return outcome == NOTHING
+    # Outside the catalogue: not explained, nothing visible, or a proxy that leaves a gap.
+    if outcome in (NOT_EXPLAINED, NOTHING):
+        return True
+    after = summary.get("gap_after")
+    return after is not None and float(after) > NOISE_GAP
+
+
+def confusion_matrix(rows: pd.DataFrame) -> pd.DataFrame:
+    """Counts of outcome (columns) per hidden effect (rows), in first-seen order."""
+    hidden = list(dict.fromkeys(rows["hidden"]))
+    seen = list(dict.fromkeys(rows["outcome"]))
+    order = [o for o in seen if o not in (NOTHING, NOT_EXPLAINED)] + [
+        o for o in (NOTHING, NOT_EXPLAINED) if o in seen
+    ]
+    table = pd.crosstab(rows["hidden"], rows["outcome"]).reindex(
+        index=hidden, columns=order, fill_value=0
+    )
+    table.index.name = "hidden \\ outcome"
+    return table
+
+
+def matrix_scores(rows: pd.DataFrame) -> dict[str, Any]:
+    """Naming accuracy (catalogue rows), false-alarm rate (nothing hidden) and the outside
+    effect's share of acceptable outcomes, each with its count."""
+
+    def share(kind: str, values: pd.Series | None = None) -> tuple[float, int]:
+        mine = rows[rows["kind"] == kind]
+        if not len(mine):
+            return math.nan, 0
+        hits = mine["correct"] if values is None else values.loc[mine.index]
+        return float(hits.mean()), len(mine)
+
+    accuracy, n_catalogue = share("catalogue")
+    false_alarm, n_nothing = share("nothing", rows["outcome"] != NOTHING)
+    outside, n_outside = share("outside")
+    return {
+        "naming_accuracy": accuracy,
+        "catalogue_studies": n_catalogue,
+        "false_alarm_rate": false_alarm,
+        "null_studies": n_nothing,
+        "outside_acceptable": outside,
+        "outside_studies": n_outside,
+    }
+
+
+def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
+    """The matrix report: scores, confusion matrix and one line per study."""
+    scores = matrix_scores(rows)
+    confusion = confusion_matrix(rows).reset_index()
+
+    def pct(value: float) -> str:
+        return "-" if not math.isfinite(value) else f"{100 * value:.0f} %"
+
+    lines = [
+        f"# {title}",
+        "",
+        f"Made with `{command}`.",
+        "",
+        f"- Right effect named: {pct(scores['naming_accuracy'])} of "
+        f"{scores['catalogue_studies']} studies with a hidden catalogue effect (goal 90 %).",
+        f"- False alarms with nothing hidden: {pct(scores['false_alarm_rate'])} of "
+        f"{scores['null_studies']} (goal at most 5 %).",
+        f"- Effect outside the catalogue: {pct(scores['outside_acceptable'])} of "
+        f"{scores['outside_studies']} acceptable (nothing missing, not explained, or a proxy "
+        f"whose surrogate gap after stays above {NOISE_GAP:g}).",
+        "",
+        "Confusion matrix (studies per hidden effect and outcome):",
+        "",
+        markdown_table(confusion, ".3g"),
+        "Studies (gaps are sqrt(mean z^2); DEM gaps are the mean of the replicate runs, the "
+        "held-out ones at the load no step fitted):",
+        "",
+        markdown_table(
+            rows[
+                [
+                    "hidden",
+                    "truth_seed",
+                    "truth_friction",
+                    "truth_magnitude",
+                    "outcome",
+                    "p_find",
+                    "p_effect",
+                    "gap_before",
+                    "gap_after",
+                    "dem_gap_before",
+                    "dem_gap_after",
+                    "held_out_dem_gap_before",
+                    "held_out_dem_gap_after",
+                    "magnitude_ratio",
+                ]
+            ],
+            ".3g",
+        ),
+    ]
+    return "\n".join(lines)

@@ -1,0 +1,150 @@
+"""The validation matrix: studies per truth specification, outcomes and their summary."""
+
+import json
+import math
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from demcal.discrepancy.validation_matrix import (
+    NOT_EXPLAINED,
+    NOTHING,
+    confusion_matrix,
+    matrix_cases,
+    matrix_markdown,
+    matrix_scores,
+    placeholder_experiment,
+    study_outcome,
+)
+
+TRUTHS = Path(__file__).resolve().parents[2] / "config" / "experiments" / "truth"
+
+
+def test_cases_cover_every_spec_with_distinct_seeds():
+    specs = [TRUTHS / f"hidden_{n}.yaml" for n in ("cohesion", "none", "softer")]
+    cases = matrix_cases(specs, 2, 101)
+    assert [(c.label, c.kind, c.hidden, c.truth_seed) for c in cases] == [
+        ("cohesion", "catalogue", "cohesion", 101),
+        ("none", "nothing", "none", 101),
+        ("softer", "outside", "softer", 101),
+        ("cohesion", "catalogue", "cohesion", 102),
+        ("none", "nothing", "none", 102),
+        ("softer", "outside", "softer", 102),
+    ]
+    assert cases[3].name == "cohesion_102"
+    with pytest.raises(ValueError, match="truths per hidden effect"):
+        matrix_cases(specs, 0, 1)
+
+
+def write_study(work: Path, summary: dict, truth: dict, ranking: dict) -> None:
+    out = work / "results" / "discrepancy"
+    out.mkdir(parents=True)
+    (out / "summary.json").write_text(json.dumps(summary))
+    (out / "ranking.json").write_text(json.dumps(ranking))
+    (work / "truth.yaml").write_text(yaml.safe_dump(truth))
+
+
+def test_outcomes_are_read_from_the_study(tmp_path):
+    cohesion, none, softer = matrix_cases(
+        [TRUTHS / f"hidden_{n}.yaml" for n in ("cohesion", "none", "softer")], 1, 5
+    )
+    truth = {"parameters": {"coefficientFriction": 0.4}, "magnitude": 30000.0}
+    named = {
+        "missing": True,
+        "p_value": 0.001,
+        "gap_before": 3.0,
+        "winner": "cohesion",
+        "magnitude": 24000.0,
+        "gap_after": 0.8,
+        "dem_gap_before": 2.9,
+        "dem_gap_after": 1.1,
+        "held_out_dem_gap_before": 2.5,
+        "held_out_dem_gap_after": 0.9,
+    }
+    write_study(tmp_path / "a", named, truth, {"p_effect": 0.01, "p_runner_up": 0.02})
+    row = study_outcome(cohesion, tmp_path / "a")
+    assert (row["outcome"], row["correct"]) == ("cohesion", True)
+    assert row["magnitude_ratio"] == pytest.approx(0.8)
+    assert row["held_out_dem_gap_after"] == 0.9
+    # The same answer for a material that hides nothing is a false alarm.
+    assert study_outcome(none, tmp_path / "a")["correct"] is False
+    # A proxy for an effect outside the catalogue is acceptable only if a gap is left.
+    assert study_outcome(softer, tmp_path / "a")["correct"] is False
+    write_study(
+        tmp_path / "b",
+        {**named, "winner": None, "magnitude": None},
+        {"parameters": {"coefficientFriction": 0.4}, "magnitude": None},
+        {"ran": True, "p_effect": 0.3},
+    )
+    row = study_outcome(softer, tmp_path / "b")
+    assert (row["outcome"], row["correct"]) == (NOT_EXPLAINED, True)
+    assert math.isnan(row["truth_magnitude"]) and math.isnan(row["magnitude_ratio"])
+    write_study(
+        tmp_path / "c",
+        {"missing": False, "p_value": 0.6, "gap_before": 0.9, "winner": None},
+        {"parameters": {"coefficientFriction": 0.5}, "magnitude": None},
+        {"ran": False, "winner": None},
+    )
+    row = study_outcome(none, tmp_path / "c")
+    assert (row["outcome"], row["correct"]) == (NOTHING, True)
+    assert math.isnan(row["p_effect"]) and math.isnan(row["dem_gap_before"])
+
+
+def test_confusion_matrix_and_scores():
+    rows = pd.DataFrame(
+        {
+            "hidden": ["cohesion"] * 3 + ["rolling"] * 2 + ["none"] * 4 + ["softer"] * 2,
+            "kind": ["catalogue"] * 5 + ["nothing"] * 4 + ["outside"] * 2,
+            "outcome": [
+                "cohesion",
+                "cohesion",
+                "rolling",
+                "rolling",
+                NOTHING,
+                NOTHING,
+                NOTHING,
+                NOTHING,
+                "rolling",
+                NOT_EXPLAINED,
+                "cohesion",
+            ],
+            "correct": [True, True, False, True, False, True, True, True, False, True, False],
+        }
+    )
+    table = confusion_matrix(rows)
+    assert list(table.index) == ["cohesion", "rolling", "none", "softer"]
+    assert list(table.columns) == ["cohesion", "rolling", NOTHING, NOT_EXPLAINED]
+    assert table.loc["cohesion"].tolist() == [2, 1, 0, 0]
+    assert table.loc["none"].tolist() == [0, 1, 3, 0]
+    scores = matrix_scores(rows)
+    assert scores["naming_accuracy"] == pytest.approx(3 / 5)
+    assert scores["false_alarm_rate"] == pytest.approx(1 / 4)
+    assert (scores["outside_acceptable"], scores["outside_studies"]) == (0.5, 2)
+    full = rows.assign(
+        truth_seed=1, truth_friction=0.4, truth_magnitude=1.0, p_find=0.01, p_effect=0.01
+    )
+    for column in (
+        "gap_before",
+        "gap_after",
+        "dem_gap_before",
+        "dem_gap_after",
+        "held_out_dem_gap_before",
+        "held_out_dem_gap_after",
+        "magnitude_ratio",
+    ):
+        full[column] = 1.0
+    text = matrix_markdown(full, "Matrix", "python scripts/discrepancy_matrix.py")
+    assert "Right effect named: 60 % of 5 studies" in text
+    assert "False alarms with nothing hidden: 25 % of 4" in text
+    assert "| cohesion | 2 | 1 | 0 | 0 |" in text
+
+
+def test_placeholder_has_every_fitted_and_held_out_load():
+    config = {
+        "shear_cell": {"normal_stresses": [1068.0, 2029.0], "P": [0.5]},
+        "discrepancy": {"held_out": [{"normal_stress": 1500.0, "P": 0.5}]},
+    }
+    loads = [(c["normal_stress"], c["P"]) for c in placeholder_experiment(config)["shear_cell"]]
+    assert loads == [(1068.0, 0.5), (2029.0, 0.5), (1500.0, 0.5)]
