@@ -37,8 +37,10 @@ from demcal.discrepancy.synthetic import study_config, write_hidden_effect_exper
 from demcal.discrepancy.truths import load_truth_spec
 
 __all__ = [
+    "GAP_COLUMNS",
     "NOTHING",
     "NOT_EXPLAINED",
+    "REPORT_COLUMNS",
     "MatrixCase",
     "confusion_matrix",
     "matrix_cases",
@@ -56,6 +58,27 @@ NOTHING = "nothing missing"
 NOT_EXPLAINED = "not explained"
 #: Experiment file of a study, relative to its directory.
 EXPERIMENT = "config/experiments/measured.yaml"
+#: Gap figures of a study row (NaN where the study did not reach the step).
+GAP_COLUMNS = (
+    "gap_before",
+    "gap_after",
+    "dem_gap_before",
+    "dem_gap_after",
+    "held_out_dem_gap_before",
+    "held_out_dem_gap_after",
+)
+#: Columns of the per-study table of the matrix report.
+REPORT_COLUMNS = (
+    "hidden",
+    "truth_seed",
+    "truth_friction",
+    "truth_magnitude",
+    "outcome",
+    "p_find",
+    "p_effect",
+    *GAP_COLUMNS,
+    "magnitude_ratio",
+)
 #: Largest surrogate gap after a proxy that still counts as explained (|z| ~ 1 is noise).
 NOISE_GAP = 1.5
 
@@ -355,26 +378,6 @@ def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
         "Studies (gaps are sqrt(mean z^2); DEM gaps are the mean of the replicate runs, the "
         "held-out ones at the load no step fitted):",
         "",
-        markdown_table(
-            rows[
-                [
-                    "hidden",
-                    "truth_seed",
-                    "truth_friction",
-                    "truth_magnitude",
-                    "outcome",
-                    "p_find",
-                    "p_effect",
-                    "gap_before",
-                    "gap_after",
-                    "dem_gap_before",
-                    "dem_gap_after",
-                    "held_out_dem_gap_before",
-                    "held_out_dem_gap_after",
-                    "magnitude_ratio",
-                ]
-            ],
-            ".3g",
-        ),
+        markdown_table(rows[list(REPORT_COLUMNS)], ".3g"),
     ]
     return "\n".join(lines)

@@ -9,6 +9,7 @@ import pytest
 import yaml
 
 from demcal.discrepancy.validation_matrix import (
+    GAP_COLUMNS,
     NOT_EXPLAINED,
     NOTHING,
     confusion_matrix,
@@ -125,15 +126,7 @@ def test_confusion_matrix_and_scores():
     full = rows.assign(
         truth_seed=1, truth_friction=0.4, truth_magnitude=1.0, p_find=0.01, p_effect=0.01
     )
-    for column in (
-        "gap_before",
-        "gap_after",
-        "dem_gap_before",
-        "dem_gap_after",
-        "held_out_dem_gap_before",
-        "held_out_dem_gap_after",
-        "magnitude_ratio",
-    ):
+    for column in (*GAP_COLUMNS, "magnitude_ratio"):
         full[column] = 1.0
     text = matrix_markdown(full, "Matrix", "python scripts/discrepancy_matrix.py")
     assert "Right effect named: 60 % of 5 studies" in text
