@@ -174,7 +174,7 @@ def rank(
         rows.append({**row, "status": "scored", "signature": signature})
     # dBIC orders the candidates; the bootstrap tests below decide whether the top one is named.
     scored, winner_name = rank_candidates(
-        null_weighted.deviance, fits, len(obs), -np.inf, float(settings["min_explained"])
+        null_weighted.deviance, fits, len(obs), float(settings["min_explained"])
     )
     unscored = [r["candidate"] for r in rows if r["status"].startswith("not scored")]
     if winner_name is not None and unscored:

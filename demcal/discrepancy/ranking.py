@@ -179,10 +179,12 @@ def rank_candidates(
     null_deviance: float,
     fits: Mapping[str, CandidateFit],
     n_observations: int,
-    min_delta_bic: float,
     min_explained: float = 0.0,
 ) -> tuple[pd.DataFrame, str | None]:
     """Rank candidate effects by their BIC advantage over "nothing missing".
+
+    dBIC only orders the candidates; whether the leader is named is decided by the bootstrap
+    tests of :func:`naming_test`.
 
     Parameters
     ----------
@@ -192,19 +194,18 @@ def rank_candidates(
         Candidate name -> its :class:`CandidateFit`.
     n_observations : int
         Number of observations N.
-    min_delta_bic : float
-        Smallest dBIC for the top candidate to be named.
     min_explained : float
-        Smallest share of D_0 the top candidate must remove to be named.
+        Smallest share of D_0 the top candidate must remove to lead.
 
     Returns
     -------
     table : DataFrame
         One row per candidate, best first: rank, candidate, magnitude, deviance,
         delta_deviance (D_0 - D_c), delta_bic, explained (fraction of D_0 removed), gap
-        (sqrt(D_c / N)) and named (bool).
+        (sqrt(D_c / N)) and named (bool: the leader).
     winner : str or None
-        The named candidate, or None when none beats "nothing missing" clearly.
+        The leader: the top candidate if it removes at least ``min_explained`` of D_0, else
+        None.
     """
     if n_observations < 1:
         raise ValueError("need at least one observation")
@@ -240,11 +241,7 @@ def rank_candidates(
     table = table.sort_values("delta_bic", ascending=False, kind="stable").reset_index(drop=True)
     table.insert(0, "rank", np.arange(1, len(table) + 1))
     winner = None
-    if (
-        len(table)
-        and table["delta_bic"].iloc[0] >= min_delta_bic
-        and table["explained"].iloc[0] >= min_explained
-    ):
+    if len(table) and table["explained"].iloc[0] >= min_explained:
         winner = str(table["candidate"].iloc[0])
     table["named"] = table["candidate"] == winner
     return table, winner
