@@ -1,13 +1,18 @@
-"""Produce a synthetic experiment file by running the engine at the true parameters.
+"""Produce a synthetic experiment file by running the virtual tests at the true parameters.
+
+The truth runs use --truth-engine (default LIGGGHTS 3.8 when installed, else the profile's
+engine), so that the measurements come from another code than the model under calibration.
 
 Usage: python scripts/make_synthetic_experiment.py --config config/tiny.yaml \\
     --truth config/experiments/truth/synthetic_reference.yaml \\
-    --out config/experiments/synthetic_reference_tiny.yaml [--noise 0.01] [--seed 1]
+    --out config/experiments/synthetic_reference_tiny.yaml [--noise 0.01] [--seed 1] \\
+    [--truth-engine "liggghts -in {deck}"]
 """
 
 import argparse
 
 from demcal.bulk.synthetic import write_synthetic_experiment
+from demcal.discrepancy.synthetic import default_truth_engine
 
 
 def main() -> None:
@@ -21,6 +26,12 @@ def main() -> None:
         "--observables", default="mu_psh,mu_sh,rho_b", help="shear-cell readings to keep"
     )
     parser.add_argument("--P", default=None, help="shear load fractions to keep, comma-separated")
+    parser.add_argument(
+        "--truth-engine",
+        default=default_truth_engine(),
+        help="command template of the truth runs (default: 'liggghts -in {deck}' when "
+        "LIGGGHTS is installed, else the profile's engine)",
+    )
     args = parser.parse_args()
     write_synthetic_experiment(
         args.config,
@@ -30,6 +41,7 @@ def main() -> None:
         args.seed,
         observables=args.observables.split(","),
         p_values=[float(p) for p in args.P.split(",")] if args.P else None,
+        truth_engine=args.truth_engine,
     )
     print(f"wrote {args.out}")
 

@@ -124,8 +124,10 @@ def write_synthetic_experiment(
     seed: int = 1,
     observables: Sequence[str] = ("mu_psh", "mu_sh", "rho_b"),
     p_values: Sequence[float] | None = None,
+    truth_engine: str | None = None,
 ) -> Path:
-    """Run the engine at the true parameters of a truth file and write an experiment file.
+    """Run the virtual tests at the true parameters of a truth file and write an experiment
+    file.
 
     Parameters
     ----------
@@ -137,6 +139,10 @@ def write_synthetic_experiment(
         Experiment file to write.
     noise, seed, observables, p_values
         As in :func:`experiment_record`.
+    truth_engine : str, optional
+        Command template of the truth runs (e.g. ``liggghts -in {deck}``), so that the
+        measurements come from another code than the model under calibration; default the
+        configuration's ``engine.command``.
 
     Returns
     -------
@@ -144,6 +150,9 @@ def write_synthetic_experiment(
         ``out_path``.
     """
     config = load_config(config_path)
+    if truth_engine is not None:
+        config["engine"] = {**config["engine"], "command": truth_engine}
+    engine = str(config["engine"]["command"])
     truth = yaml.safe_load(Path(truth_path).read_text())
     with tempfile.TemporaryDirectory() as tmp:
         bulk = simulate_reference(truth["parameters"], config, tmp)
@@ -152,7 +161,7 @@ def write_synthetic_experiment(
         f"{truth['material']} ({config['profile']} profile)",
         noise,
         seed,
-        f"dem_engine at the parameters of {Path(truth_path).name}, {config_path}, "
+        f"`{engine}` at the parameters of {Path(truth_path).name}, {config_path}, "
         f"noise {noise:.1%}",
         observables=tuple(observables),
         p_values=tuple(float(p) for p in p_values) if p_values else None,
