@@ -182,7 +182,7 @@ def gap_table(
 
     Returns
     -------
-    DataFrame, shape (K, 20)
+    DataFrame, shape (K, 22)
         Also ``sigma_common`` (the larger sigma of the two models), the misfits of both
         models on it (``z_before_common``, ``z_after_common``), the DEM means, their sd and
         number of runs, and ``held_out``.
