@@ -186,6 +186,12 @@ def verification_case_ids(config: Mapping[str, Any], test: str) -> list[str]:
     return [f"{base}{suffix}" for base in bases for suffix in shear_suffixes(config)]
 
 
+def seed_of_replicate(config: Mapping[str, Any], k: int) -> int:
+    """Insertion seed of replicate ``k`` (1-based) of a run: the configuration's seed for the
+    first, then steps of :data:`REPLICATE_SEED_STEP`."""
+    return int(config["seed"]) + (int(k) - 1) * REPLICATE_SEED_STEP
+
+
 def replicate_seed(config: Mapping[str, Any], key: str) -> int:
     """Insertion seed of the verification run ``key``: the master seed for replicate 1, then
     ``seed + (k - 1) * REPLICATE_SEED_STEP`` for ``identified<k>``.
@@ -198,5 +204,4 @@ def replicate_seed(config: Mapping[str, Any], key: str) -> int:
     match = _REPLICATE_KEY.fullmatch(key)
     if match is None:
         raise KeyError(f"{key!r} is not a verification case id")
-    k = int(match.group("k") or 1)
-    return int(config["seed"]) + (k - 1) * REPLICATE_SEED_STEP
+    return seed_of_replicate(config, int(match.group("k") or 1))

@@ -20,7 +20,7 @@ from typing import Any
 
 from demcal.core.config import ConfigError
 from demcal.core.experiments import Experiment
-from demcal.design.cases import REPLICATE_SEED_STEP, load_condition
+from demcal.design.cases import load_condition, seed_of_replicate
 
 __all__ = [
     "RunId",
@@ -92,9 +92,8 @@ def replicate_bases(run: str, count: int) -> list[str]:
 
 
 def run_seed(config: Mapping[str, Any], case_id: str) -> int:
-    """Insertion seed of a run: the configuration's for replicate 1, then steps of
-    :data:`~demcal.design.cases.REPLICATE_SEED_STEP`."""
-    return int(config["seed"]) + (parse_run_id(case_id).replicate - 1) * REPLICATE_SEED_STEP
+    """Insertion seed of a run (:func:`demcal.design.cases.seed_of_replicate`)."""
+    return seed_of_replicate(config, parse_run_id(case_id).replicate)
 
 
 def held_out_conditions(config: Mapping[str, Any]) -> list[tuple[float, float]]:
