@@ -44,6 +44,7 @@ __all__ = [
     "study_config",
     "study_overrides",
     "write_hidden_effect_experiment",
+    "write_truth",
 ]
 
 #: Relative measurement noise added per observable: repeated shear tests scatter by a few per
@@ -184,7 +185,14 @@ def prepare_study(
         truth_seed=truth_seed,
         truth_engine=truth_engine if truth_engine is not None else default_truth_engine(),
     )
-    (study_dir / "truth.yaml").write_text(
+    write_truth(study_dir, truth)
+    return path
+
+
+def write_truth(study_dir: str | Path, truth: DrawnTruth) -> Path:
+    """Write the drawn truth beside a study (``truth.yaml``), where the workflow never looks."""
+    path = Path(study_dir) / "truth.yaml"
+    path.write_text(
         "# The drawn truth of this study; the workflow never reads it.\n"
         + yaml.safe_dump(truth.record(), sort_keys=False)
     )

@@ -33,7 +33,11 @@ import yaml
 
 from demcal.core.config import validate_config
 from demcal.discrepancy.report import markdown_table
-from demcal.discrepancy.synthetic import study_config, write_hidden_effect_experiment
+from demcal.discrepancy.synthetic import (
+    study_config,
+    write_hidden_effect_experiment,
+    write_truth,
+)
 from demcal.discrepancy.truths import load_truth_spec
 
 __all__ = [
@@ -257,7 +261,7 @@ def run_case(
             truth_engine=truth_engine,
         )
         shutil.rmtree(work / "truth_runs")
-        (work / "truth.yaml").write_text(yaml.safe_dump(truth.record(), sort_keys=False))
+        write_truth(work, truth)
     _snakemake(work, cores, work / "discrepancy.log", "discrepancy")
     return study_outcome(case, work)
 
