@@ -20,7 +20,7 @@ import pandas as pd
 import yaml
 
 from demcal.discrepancy.candidates import parse_candidates
-from demcal.discrepancy.synthetic import default_truth_engine, study_config
+from demcal.discrepancy.synthetic import study_config
 from demcal.discrepancy.truths import load_truth_spec
 from demcal.discrepancy.validation_matrix import (
     matrix_cases,
@@ -29,6 +29,7 @@ from demcal.discrepancy.validation_matrix import (
     run_case,
     study_outcome,
 )
+from demcal.engine_io.run import installed_liggghts
 
 ROOT = Path(__file__).resolve().parents[1]
 TRUTHS = ROOT / "config" / "experiments" / "truth"
@@ -53,7 +54,7 @@ def main() -> None:
     parser.add_argument("--truths", type=int, default=5, help="drawn truths per hidden effect")
     parser.add_argument("--first-seed", type=int, default=101, help="seed of the first truth")
     parser.add_argument("--spec", type=Path, nargs="*", help="truth specifications to use")
-    parser.add_argument("--truth-engine", default=default_truth_engine())
+    parser.add_argument("--truth-engine", default=installed_liggghts())
     parser.add_argument("--replicates", type=int, default=3, help="truth runs per condition")
     parser.add_argument("--cores", type=int, default=2)
     args = parser.parse_args()

@@ -18,7 +18,8 @@ Usage: python scripts/hidden_effect_study.py --profile config/config.yaml \\
 
 import argparse
 
-from demcal.discrepancy.synthetic import NOISE, default_truth_engine, prepare_study
+from demcal.discrepancy.synthetic import NOISE, prepare_study
+from demcal.engine_io.run import installed_liggghts
 
 
 def main() -> None:
@@ -29,7 +30,7 @@ def main() -> None:
     parser.add_argument("--truth-seed", type=int, default=1, help="seed of the truth draw")
     parser.add_argument(
         "--truth-engine",
-        default=default_truth_engine(),
+        default=installed_liggghts(),
         help="command template of the truth runs (default: 'liggghts -in {deck}' when "
         "LIGGGHTS is installed, else the profile's engine)",
     )

@@ -12,7 +12,7 @@ Usage: python scripts/make_synthetic_experiment.py --config config/tiny.yaml \\
 import argparse
 
 from demcal.bulk.synthetic import write_synthetic_experiment
-from demcal.discrepancy.synthetic import default_truth_engine
+from demcal.engine_io.run import installed_liggghts
 
 
 def main() -> None:
@@ -28,7 +28,7 @@ def main() -> None:
     parser.add_argument("--P", default=None, help="shear load fractions to keep, comma-separated")
     parser.add_argument(
         "--truth-engine",
-        default=default_truth_engine(),
+        default=installed_liggghts(),
         help="command template of the truth runs (default: 'liggghts -in {deck}' when "
         "LIGGGHTS is installed, else the profile's engine)",
     )

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import copy
 import math
-import shutil
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -34,10 +33,10 @@ from demcal.design.cases import shear_suffixes
 from demcal.discrepancy.candidates import deep_merge
 from demcal.discrepancy.dem_check import held_out_suffixes, run_load
 from demcal.discrepancy.truths import DrawnTruth, draw_truth, load_truth_spec, truth_config
+from demcal.engine_io.run import installed_liggghts
 
 __all__ = [
     "NOISE",
-    "default_truth_engine",
     "hidden_effect_bulk",
     "prepare_study",
     "replicate_record",
@@ -121,11 +120,6 @@ def study_config(raw: Mapping[str, Any], profile: str | None = None) -> dict[str
     return out
 
 
-def default_truth_engine() -> str | None:
-    """``liggghts -in {deck}`` when LIGGGHTS is installed, else None (the study's engine)."""
-    return "liggghts -in {deck}" if shutil.which("liggghts") else None
-
-
 def prepare_study(
     profile_config: str | Path,
     truth_path: str | Path,
@@ -156,7 +150,7 @@ def prepare_study(
     truth_seed : int
         Seed of the truth draw.
     truth_engine : str, optional
-        Command template of the truth runs; default :func:`default_truth_engine`.
+        Command template of the truth runs; default :func:`demcal.engine_io.run.installed_liggghts`.
 
     Returns
     -------
@@ -183,7 +177,7 @@ def prepare_study(
         workers=workers,
         replicates=replicates,
         truth_seed=truth_seed,
-        truth_engine=truth_engine if truth_engine is not None else default_truth_engine(),
+        truth_engine=truth_engine if truth_engine is not None else installed_liggghts(),
     )
     write_truth(study_dir, truth)
     return path

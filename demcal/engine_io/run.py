@@ -13,6 +13,12 @@ from pathlib import Path
 MAX_WARNINGS = 20
 
 
+def installed_liggghts() -> str | None:
+    """``liggghts -in {deck}`` when LIGGGHTS is on the PATH, else None: the default engine of
+    runs whose data must come from another code than the model under calibration."""
+    return "liggghts -in {deck}" if shutil.which("liggghts") else None
+
+
 def engine_command(template: str, deck: str, threads: int) -> list[str]:
     """The command line for one deck, from the ``engine.command`` template.
 
