@@ -115,7 +115,8 @@ def show(
         summary["reason"] = (
             "nothing is missing (gap within noise)"
             if not find_rec["missing"]
-            else "no candidate beats 'nothing missing' clearly"
+            else "no candidate named: "
+            + ("; ".join(ranking_rec.get("notes") or []) or "none beats 'nothing missing' clearly")
         )
         return table, summary
     gap_before = gap_of(fitted["z_before_common"])

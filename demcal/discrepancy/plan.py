@@ -62,7 +62,10 @@ class DiscrepancyPlan:
     held_out : list[str]
         Suffixes ``_h<m>`` of the held-out conditions (DEM check only).
     replicates : int
-        DEM runs per point and load in the DEM check.
+        DEM runs per point and load in the DEM check; the reference at theta* runs this many
+        times before the naming too.
+    probe_replicates : int
+        DEM runs of every candidate probe level.
     """
 
     root: str
@@ -72,6 +75,7 @@ class DiscrepancyPlan:
     candidates: list[Candidate]
     held_out: list[str]
     replicates: int
+    probe_replicates: int = 1
 
     @classmethod
     def from_config(cls, config: Mapping[str, Any], results: str = "results") -> DiscrepancyPlan:
@@ -90,6 +94,7 @@ class DiscrepancyPlan:
             candidates=candidates,
             held_out=held_out_suffixes(config),
             replicates=int(config["discrepancy"]["replicates"]),
+            probe_replicates=int(config["discrepancy"]["probe_replicates"]),
         )
 
     def case_ids(self, bases: Sequence[str], held_out: bool = False) -> list[tuple[str, str]]:
@@ -114,7 +119,13 @@ class DiscrepancyPlan:
 
     @property
     def probe_cases(self) -> list[str]:
-        return [run.case for run in probe_runs(self.candidates)]
+        """Run ids of the probe stage: every replicate of the reference at theta*, then
+        ``probe_replicates`` runs of every candidate level."""
+        cases = []
+        for run in probe_runs(self.candidates):
+            count = self.replicates if run.candidate is None else self.probe_replicates
+            cases += replicate_bases(run.case, count)
+        return cases
 
     def probe_bulk(self, find_record: str | Path) -> list[str]:
         """Bulk files of all probe runs, or none when Find found nothing missing."""

@@ -22,7 +22,7 @@ from demcal.discrepancy.candidates import (
     extended_design,
     parse_candidates,
 )
-from demcal.discrepancy.dem_check import fitted_experiment
+from demcal.discrepancy.dem_check import fitted_experiment, replicate_bases
 from demcal.discrepancy.effect_response import EffectResponse, response_signature
 from demcal.discrepancy.find import FindResult, find
 from demcal.discrepancy.model_from_files import (
@@ -40,7 +40,7 @@ from demcal.discrepancy.ranking import (
     ranking_sigma,
 )
 from demcal.discrepancy.report import condition_label, ranking_markdown
-from demcal.discrepancy.run_results import read_runs, run_values
+from demcal.discrepancy.run_results import read_runs, replicate_statistics
 
 __all__ = ["RankingResult", "rank", "ranking_record", "write_ranking"]
 
@@ -88,24 +88,29 @@ def rank(
     ``probe_point`` is the parameter set the probes ran at (``point`` of the Find record); it
     gives the "absent" magnitude of a candidate whose absence is another parameter's value.
 
-    Observations whose reference probe run gave no value are left out of the ranking (and the
-    null fit is redone without them); a probe level with a missing value is dropped for its
-    candidate; a candidate without any usable level is reported as not scored.
+    The reference is the mean of the ``discrepancy.replicates`` runs at theta* and a probe
+    level the mean of its ``discrepancy.probe_replicates`` runs, each over the runs that
+    finished. Observations without a value in any reference run are left out of the ranking
+    (and the null fit is redone without them); a probe level without a value in any of its runs
+    is dropped for its candidate; a candidate without any usable level is reported as not
+    scored.
     """
     settings = config["discrepancy"]
+    n_reference = int(settings["replicates"])
+    n_probe = int(settings["probe_replicates"])
     candidates = parse_candidates(settings["candidates"])
     surrogates, rmse = load_surrogates(model_paths)
     model, box = build_model(surrogates, rmse, experiment, config)
     obs = model.observations
     notes: list[str] = []
-    reference = run_values(runs, REFERENCE_CASE, obs)
+    reference = _mean_of_runs(runs, REFERENCE_CASE, n_reference, obs)
     keep = np.isfinite(reference)
     if not keep.any():
-        raise ValueError("the reference probe run gave no value for any observation")
+        raise ValueError("the reference probe runs gave no value for any observation")
     if not keep.all():
         dropped = obs[~keep]
         notes.append(
-            "left out (no value in the reference run): "
+            "left out (no value in any reference run): "
             + ", ".join(f"{r.observable} at {r.normal_stress:g} Pa" for r in dropped.itertuples())
         )
         model = SurrogateModel(surrogates, obs[keep], model.parameters, surrogate_constants(config))
@@ -122,7 +127,7 @@ def rank(
     grid = box.grid(int(settings["grid_points"]))
     predictions = model.predict(grid)
     noise = obs["surrogate_rmse"].to_numpy(float)
-    weights = ranking_sigma(obs["sigma"].to_numpy(float), noise)
+    weights = ranking_sigma(obs["sigma"].to_numpy(float), noise, n_probe, n_reference)
     null_weighted = null_fit(model, box, grid, predictions, weights)
     point = {k: float(v) for k, v in probe_point.items()}
     fits = {}
@@ -140,12 +145,15 @@ def rank(
             continue
         mags, values = [], []
         for j, level in enumerate(cand.probe_levels):
-            vals = run_values(runs, cand.case_id(j), obs)
+            vals = _mean_of_runs(runs, cand.case_id(j), n_probe, obs)
             if np.all(np.isfinite(vals)):
                 mags.append(level)
                 values.append(vals)
             else:
-                notes.append(f"{cand.name}: probe level {level:g} dropped (a run gave no value)")
+                notes.append(
+                    f"{cand.name}: probe level {level:g} dropped (no run gave a value for "
+                    "every observation)"
+                )
         if not mags:
             rows.append({**row, "status": "not scored: no usable probe run"})
             continue
@@ -212,6 +220,13 @@ def rank(
     return RankingResult(table, winner, fits, null, null_weighted.deviance, notes, test)
 
 
+def _mean_of_runs(runs: pd.DataFrame, run: str, count: int, obs: pd.DataFrame) -> np.ndarray:
+    """Mean DEM value of each observation over the ``count`` replicates of ``run`` that gave
+    one (NaN where none did), shape (K,)."""
+    mean, _, _ = replicate_statistics(runs, replicate_bases(run, count), obs)
+    return mean
+
+
 def _tested_winner(
     leader: str, test: NamingTest, alpha: float, obs: pd.DataFrame, notes: list[str]
 ) -> str | None:
@@ -250,6 +265,7 @@ def ranking_record(result: RankingResult) -> dict[str, Any]:
         "null_deviance": result.null_deviance,
         "notes": result.notes,
         "p_effect": result.test.p_effect if result.test else None,
+        "top": result.test.top if result.test else None,
         "runner_up": result.test.runner_up if result.test else None,
         "p_runner_up": result.test.p_runner_up if result.test else None,
         "ranking": [
@@ -346,6 +362,8 @@ def write_ranking(
             float(settings["alpha"]),
             float(settings["min_explained"]),
             result.notes,
+            probe_runs=int(settings["probe_replicates"]),
+            reference_runs=int(settings["replicates"]),
         )
     )
     if result.winner is not None:

@@ -86,8 +86,14 @@ class CandidateFit:
     best: BestFit
 
 
-def ranking_sigma(sigma: np.ndarray, noise_sd: np.ndarray) -> np.ndarray:
-    """Weights of the ranking, ``sqrt(sigma^2 + 2 noise^2)``, shape (K,).
+def ranking_sigma(
+    sigma: np.ndarray, noise_sd: np.ndarray, probe_runs: int = 1, reference_runs: int = 1
+) -> np.ndarray:
+    """Weights of the ranking, ``sqrt(sigma^2 + (1 / n_p + 1 / n_ref) noise^2)``, shape (K,).
+
+    A candidate's response is the mean of ``n_p`` probe runs minus the mean of ``n_ref``
+    reference runs, so its seed-to-seed scatter adds ``(1 / n_p + 1 / n_ref) noise^2`` to the
+    variance of the observation (``2 noise^2`` for single runs).
 
     Parameters
     ----------
@@ -95,8 +101,13 @@ def ranking_sigma(sigma: np.ndarray, noise_sd: np.ndarray) -> np.ndarray:
         Uncertainty of each observation in the Find step.
     noise_sd : ndarray, shape (K,)
         Noise of one DEM run per observation (the surrogate RMSE).
+    probe_runs, reference_runs : int
+        Runs averaged per probe level and at the reference point (at least 1).
     """
-    return np.sqrt(np.asarray(sigma, float) ** 2 + 2.0 * np.asarray(noise_sd, float) ** 2)
+    if probe_runs < 1 or reference_runs < 1:
+        raise ValueError(f"run counts must be at least 1, got {probe_runs}, {reference_runs}")
+    share = 1.0 / probe_runs + 1.0 / reference_runs
+    return np.sqrt(np.asarray(sigma, float) ** 2 + share * np.asarray(noise_sd, float) ** 2)
 
 
 def null_fit(

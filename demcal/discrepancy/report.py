@@ -109,8 +109,14 @@ def ranking_markdown(
     min_explained: float = 0.0,
     notes: Sequence[str] = (),
     verdict: str | None = None,
+    probe_runs: int = 1,
+    reference_runs: int = 1,
 ) -> str:
-    """The Name report: the ranking with scores, fitted magnitudes and signatures."""
+    """The Name report: the ranking with scores, fitted magnitudes and signatures.
+
+    ``probe_runs`` and ``reference_runs`` are the DEM runs averaged per probe level and at
+    theta*; they set the response's share of the weights.
+    """
     lines = ["# Discrepancy - Name: which effect explains the gap", ""]
     if verdict is not None:
         lines += [f"Not run: {verdict}.", ""]
@@ -119,13 +125,14 @@ def ranking_markdown(
     lines += [
         "Score: dBIC = D_0 - D_c - ln N against 'nothing missing' (one extra parameter; "
         f"N = {n_observations}, ln N = {penalty:.2f}), D = sum ((model - measured) / s)^2 with "
-        "s^2 = sigma^2 + 2 RMSE^2 (a probe response is the difference of two DEM runs); "
+        f"s^2 = sigma^2 + (1/{probe_runs} + 1/{reference_runs}) RMSE^2 (a probe response is "
+        f"the mean of {probe_runs} DEM run(s) minus the mean of {reference_runs} at theta*); "
         "explained = share of D_0 removed; gap = sqrt(D_c / N). dBIC orders the candidates; "
         "the top one is named when a parametric bootstrap rejects both 'nothing missing' and "
         f"'the runner-up is the effect' at alpha = {alpha:g}, and explained >= "
         f"{min_explained:g}.",
         "",
-        f"**Named: {winner}.**" if winner else "**No candidate beats 'nothing missing' clearly.**",
+        f"**Named: {winner}.**" if winner else "**No candidate named** (why: the notes below).",
         "",
     ]
     shown = table.copy()

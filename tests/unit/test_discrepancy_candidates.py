@@ -1,6 +1,7 @@
 """The candidate catalogue, its applicability and the cases of the discrepancy workflow."""
 
 import copy
+import dataclasses
 from pathlib import Path
 
 import pytest
@@ -152,12 +153,20 @@ def test_probe_runs_and_plan_file_lists(study, tmp_path):
     find.write_text('{"missing": false}')
     assert plan.probe_bulk(find) == []
     find.write_text('{"missing": true}')
-    # Probe runs only at the fitted loads, one run each: they feed the naming.
+    # Probe runs only at the fitted loads: they feed the naming. The reference runs as often as
+    # the DEM check needs it (2 here), each candidate level once by default.
     assert plan.probe_bulk(find) == [
         f"results/discrepancy/probes/shear_cell/{c}_s{k}/bulk.csv"
-        for c in ("ref", "cohesion1", "cohesion2", "cohesion3")
+        for c in ("ref", "ref_r2", "cohesion1", "cohesion2", "cohesion3")
         for k in (1, 2)
     ]
+    triple = dataclasses.replace(plan, probe_replicates=3)
+    assert triple.probe_cases == [
+        "ref", "ref_r2",
+        "cohesion1", "cohesion1_r2", "cohesion1_r3",
+        "cohesion2", "cohesion2_r2", "cohesion2_r3",
+        "cohesion3", "cohesion3_r2", "cohesion3_r3",
+    ]  # fmt: skip
     ranking = tmp_path / "ranking.json"
     ranking.write_text('{"winner": null}')
     # The DEM check: every replicate of the reference, at the fitted and the held-out loads.

@@ -110,6 +110,23 @@ def test_fit_recovers_the_hidden_magnitude():
     assert fit.best.deviance < 1.0
 
 
+def test_ranking_weights_count_the_scatter_of_replicate_means():
+    # The response is mean(n_p probe runs) - mean(n_ref reference runs): its scatter, drawn
+    # here, is what the weights add to sigma.
+    rng = np.random.default_rng(5)
+    noise = np.array([0.05, 20.0])
+    sigma = np.array([0.03, 10.0])
+    for n_p, n_ref in ((1, 1), (1, 3), (3, 3)):
+        draws = rng.normal(0.0, noise, (40_000, n_p, 2)).mean(axis=1) - rng.normal(
+            0.0, noise, (40_000, n_ref, 2)
+        ).mean(axis=1)
+        expected = np.sqrt(sigma**2 + draws.var(axis=0))
+        assert ranking_sigma(sigma, noise, n_p, n_ref) == pytest.approx(expected, rel=0.01)
+    assert ranking_sigma(sigma, noise) == pytest.approx(np.sqrt(sigma**2 + 2 * noise**2))
+    with pytest.raises(ValueError, match="at least 1"):
+        ranking_sigma(sigma, noise, 0, 3)
+
+
 def test_ranking_names_the_effect_that_explains_the_gap():
     model, grid, F = setup(magnitude=1.0)
     noise = model.observations["surrogate_rmse"].to_numpy()
