@@ -41,6 +41,7 @@ from demcal.discrepancy.synthetic import (
 from demcal.discrepancy.truths import load_truth_spec
 
 __all__ = [
+    "AMBIGUOUS",
     "GAP_COLUMNS",
     "NOTHING",
     "NOT_EXPLAINED",
@@ -60,6 +61,9 @@ __all__ = [
 NOTHING = "nothing missing"
 #: Outcome when something is missing but no candidate is named.
 NOT_EXPLAINED = "not explained"
+#: Start of the outcome when the two leading candidates cannot be told apart
+#: (``"ambiguous: a / b"``, names in alphabetical order).
+AMBIGUOUS = "ambiguous"
 #: Experiment file of a study, relative to its directory.
 EXPERIMENT = "config/experiments/measured.yaml"
 #: Gap figures of a study row (NaN where the study did not reach the step).
@@ -80,6 +84,7 @@ REPORT_COLUMNS = (
     "outcome",
     "p_find",
     "p_effect",
+    "p_runner_up",
     *GAP_COLUMNS,
     "magnitude_ratio",
 )
@@ -273,10 +278,15 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
     summary = json.loads((out / "summary.json").read_text())
     truth = yaml.safe_load((work / "truth.yaml").read_text())
     ranking = json.loads((out / "ranking.json").read_text())
+    pair = _ambiguous_pair(summary, ranking)
     if not summary["missing"]:
         outcome = NOTHING
+    elif summary.get("winner"):
+        outcome = summary["winner"]
+    elif pair:
+        outcome = f"{AMBIGUOUS}: {pair[0]} / {pair[1]}"
     else:
-        outcome = summary.get("winner") or NOT_EXPLAINED
+        outcome = NOT_EXPLAINED
     magnitude = summary.get("magnitude")
     truth_magnitude = truth.get("magnitude")
     ratio = math.nan
@@ -291,6 +301,7 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
         "truth_magnitude": truth_magnitude if truth_magnitude is not None else nan,
         "outcome": outcome,
         "correct": _correct(case, outcome, summary),
+        "shortlisted": case.kind == "catalogue" and (outcome == case.hidden or case.hidden in pair),
         "p_find": summary["p_value"],
         "p_effect": ranking.get("p_effect", nan) if ranking.get("ran", True) else nan,
         "p_runner_up": ranking.get("p_runner_up", nan) if ranking.get("ran", True) else nan,
@@ -305,13 +316,31 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
     }
 
 
+def _ambiguous_pair(summary: Mapping[str, Any], ranking: Mapping[str, Any]) -> tuple[str, ...]:
+    """The two leading candidates, alphabetically, when the naming found an effect but could
+    not tell them apart (p_effect < alpha <= p_runner_up); else empty."""
+    if not summary.get("missing") or summary.get("winner") or not ranking.get("ran", True):
+        return ()
+    alpha = float(summary.get("alpha", 0.05))
+    # A record without "top": its ranking lists the candidates best first.
+    listed = ranking.get("ranking") or [{}]
+    top, runner_up = ranking.get("top") or listed[0].get("candidate"), ranking.get("runner_up")
+    p_effect, p_runner_up = ranking.get("p_effect"), ranking.get("p_runner_up")
+    if top is None or runner_up is None or p_effect is None or p_runner_up is None:
+        return ()
+    if float(p_effect) < alpha <= float(p_runner_up):
+        return tuple(sorted((str(top), str(runner_up))))
+    return ()
+
+
 def _correct(case: MatrixCase, outcome: str, summary: Mapping[str, Any]) -> bool:
     if case.kind == "catalogue":
         return outcome == case.hidden
     if case.kind == "nothing":
         return outcome == NOTHING
-    # Outside the catalogue: not explained, nothing visible, or a proxy that leaves a gap.
-    if outcome in (NOT_EXPLAINED, NOTHING):
+    # Outside the catalogue: not explained (ambiguous included), nothing visible, or a proxy
+    # that leaves a gap.
+    if outcome in (NOT_EXPLAINED, NOTHING) or outcome.startswith(AMBIGUOUS):
         return True
     after = summary.get("gap_after")
     return after is not None and float(after) > NOISE_GAP
@@ -321,9 +350,9 @@ def confusion_matrix(rows: pd.DataFrame) -> pd.DataFrame:
     """Counts of outcome (columns) per hidden effect (rows), in first-seen order."""
     hidden = list(dict.fromkeys(rows["hidden"]))
     seen = list(dict.fromkeys(rows["outcome"]))
-    order = [o for o in seen if o not in (NOTHING, NOT_EXPLAINED)] + [
-        o for o in (NOTHING, NOT_EXPLAINED) if o in seen
-    ]
+    ambiguous = sorted(o for o in seen if o.startswith(AMBIGUOUS))
+    named = [o for o in seen if o not in (NOTHING, NOT_EXPLAINED, *ambiguous)]
+    order = named + ambiguous + [o for o in (NOTHING, NOT_EXPLAINED) if o in seen]
     table = pd.crosstab(rows["hidden"], rows["outcome"]).reindex(
         index=hidden, columns=order, fill_value=0
     )
@@ -343,11 +372,17 @@ def matrix_scores(rows: pd.DataFrame) -> dict[str, Any]:
         return float(hits.mean()), len(mine)
 
     accuracy, n_catalogue = share("catalogue")
+    shortlist = (
+        share("catalogue", rows["shortlisted"].astype(bool))[0]
+        if "shortlisted" in rows
+        else math.nan
+    )
     false_alarm, n_nothing = share("nothing", rows["outcome"] != NOTHING)
     outside, n_outside = share("outside")
     return {
         "naming_accuracy": accuracy,
         "catalogue_studies": n_catalogue,
+        "shortlist_accuracy": shortlist,
         "false_alarm_rate": false_alarm,
         "null_studies": n_nothing,
         "outside_acceptable": outside,
@@ -369,7 +404,8 @@ def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
         f"Made with `{command}`.",
         "",
         f"- Right effect named: {pct(scores['naming_accuracy'])} of "
-        f"{scores['catalogue_studies']} studies with a hidden catalogue effect (goal 90 %).",
+        f"{scores['catalogue_studies']} studies with a hidden catalogue effect (goal 90 %); "
+        f"named or one of two the data could not tell apart: {pct(scores['shortlist_accuracy'])}.",
         f"- False alarms with nothing hidden: {pct(scores['false_alarm_rate'])} of "
         f"{scores['null_studies']} (goal at most 5 %).",
         f"- Effect outside the catalogue: {pct(scores['outside_acceptable'])} of "

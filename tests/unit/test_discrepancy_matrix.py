@@ -9,6 +9,7 @@ import pytest
 import yaml
 
 from demcal.discrepancy.validation_matrix import (
+    AMBIGUOUS,
     GAP_COLUMNS,
     NOT_EXPLAINED,
     NOTHING,
@@ -82,6 +83,29 @@ def test_outcomes_are_read_from_the_study(tmp_path):
     row = study_outcome(softer, tmp_path / "b")
     assert (row["outcome"], row["correct"]) == (NOT_EXPLAINED, True)
     assert math.isnan(row["truth_magnitude"]) and math.isnan(row["magnitude_ratio"])
+    # Something is missing, but the two leaders cannot be told apart: not named, though the
+    # hidden effect is on the shortlist; for an outside effect that is acceptable.
+    write_study(
+        tmp_path / "d",
+        {**named, "winner": None, "magnitude": None, "alpha": 0.05},
+        truth,
+        {"ran": True, "p_effect": 0.001, "top": "rolling", "runner_up": "cohesion",
+         "p_runner_up": 0.145},
+    )  # fmt: skip
+    row = study_outcome(cohesion, tmp_path / "d")
+    assert row["outcome"] == f"{AMBIGUOUS}: cohesion / rolling"
+    assert (row["correct"], row["shortlisted"]) == (False, True)
+    assert study_outcome(softer, tmp_path / "d")["correct"] is True
+    # The same p-values with a clear runner-up would have named the top one: no pair.
+    write_study(
+        tmp_path / "e",
+        {**named, "winner": None, "magnitude": None, "alpha": 0.05},
+        truth,
+        {"ran": True, "p_effect": 0.2, "top": "rolling", "runner_up": "cohesion",
+         "p_runner_up": 0.5},
+    )  # fmt: skip
+    row = study_outcome(cohesion, tmp_path / "e")
+    assert (row["outcome"], row["shortlisted"]) == (NOT_EXPLAINED, False)
     write_study(
         tmp_path / "c",
         {"missing": False, "p_value": 0.6, "gap_before": 0.9, "winner": None},
@@ -114,24 +138,35 @@ def test_confusion_matrix_and_scores():
             "correct": [True, True, False, True, False, True, True, True, False, True, False],
         }
     )
+    rows.loc[4, "outcome"] = f"{AMBIGUOUS}: cohesion / rolling"
+    rows["shortlisted"] = [True, True, False, True, True] + [False] * 6
     table = confusion_matrix(rows)
     assert list(table.index) == ["cohesion", "rolling", "none", "softer"]
-    assert list(table.columns) == ["cohesion", "rolling", NOTHING, NOT_EXPLAINED]
-    assert table.loc["cohesion"].tolist() == [2, 1, 0, 0]
-    assert table.loc["none"].tolist() == [0, 1, 3, 0]
+    ambiguous = f"{AMBIGUOUS}: cohesion / rolling"
+    assert list(table.columns) == ["cohesion", "rolling", ambiguous, NOTHING, NOT_EXPLAINED]
+    assert table.loc["cohesion"].tolist() == [2, 1, 0, 0, 0]
+    assert table.loc["rolling"].tolist() == [0, 1, 1, 0, 0]
+    assert table.loc["none"].tolist() == [0, 1, 0, 3, 0]
     scores = matrix_scores(rows)
     assert scores["naming_accuracy"] == pytest.approx(3 / 5)
+    assert scores["shortlist_accuracy"] == pytest.approx(4 / 5)
     assert scores["false_alarm_rate"] == pytest.approx(1 / 4)
     assert (scores["outside_acceptable"], scores["outside_studies"]) == (0.5, 2)
     full = rows.assign(
-        truth_seed=1, truth_friction=0.4, truth_magnitude=1.0, p_find=0.01, p_effect=0.01
+        truth_seed=1,
+        truth_friction=0.4,
+        truth_magnitude=1.0,
+        p_find=0.01,
+        p_effect=0.01,
+        p_runner_up=0.2,
     )
     for column in (*GAP_COLUMNS, "magnitude_ratio"):
         full[column] = 1.0
     text = matrix_markdown(full, "Matrix", "python scripts/discrepancy_matrix.py")
     assert "Right effect named: 60 % of 5 studies" in text
     assert "False alarms with nothing hidden: 25 % of 4" in text
-    assert "| cohesion | 2 | 1 | 0 | 0 |" in text
+    assert "| cohesion | 2 | 1 | 0 | 0 | 0 |" in text
+    assert "named or one of two the data could not tell apart: 80 %" in text
 
 
 def test_placeholder_has_every_fitted_and_held_out_load():
