@@ -338,6 +338,20 @@ def verification_markdown(table: pd.DataFrame, summary: Mapping[str, Any]) -> st
             lines.append(markdown_table(_dem_columns(table, ["before"]), ".4g"))
         return "\n".join(lines) + "\n"
     params = ", ".join(f"{k} = {v:.4g}" for k, v in summary["identified"].items())
+    if summary.get("dem_confirmed"):
+        lines += [
+            f"**The DEM runs confirm {summary['winner']}**: closer to the measurements "
+            "than the current model, held-out loads within the noise or closer.",
+            "",
+        ]
+    else:
+        lines += [
+            f"**The DEM runs do not confirm {summary['winner']}**: the extended model is not "
+            "closer to the measurements in DEM than the current model, or it misses the "
+            "held-out loads by more than before. It may stand in for another effect; do not "
+            "use it without a further measurement.",
+            "",
+        ]
     lines += [
         f"Effect added: {summary['winner']} ({summary['parameter']}); identified point of the "
         f"extended model: {params}.",

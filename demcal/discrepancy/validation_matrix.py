@@ -32,6 +32,7 @@ import pandas as pd
 import yaml
 
 from demcal.core.config import validate_config
+from demcal.discrepancy.before_after import dem_confirms
 from demcal.discrepancy.report import markdown_table
 from demcal.discrepancy.synthetic import (
     study_config,
@@ -87,9 +88,8 @@ REPORT_COLUMNS = (
     "p_runner_up",
     *GAP_COLUMNS,
     "magnitude_ratio",
+    "dem_confirmed",
 )
-#: Largest surrogate gap after a proxy that still counts as explained (|z| ~ 1 is noise).
-NOISE_GAP = 1.5
 
 
 @dataclass(frozen=True)
@@ -301,6 +301,7 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
         "truth_magnitude": truth_magnitude if truth_magnitude is not None else nan,
         "outcome": outcome,
         "correct": _correct(case, outcome, summary),
+        "dem_confirmed": _confirmed(summary),
         "shortlisted": case.kind == "catalogue" and (outcome == case.hidden or case.hidden in pair),
         "p_find": summary["p_value"],
         "p_effect": ranking.get("p_effect", nan) if ranking.get("ran", True) else nan,
@@ -339,11 +340,23 @@ def _correct(case: MatrixCase, outcome: str, summary: Mapping[str, Any]) -> bool
     if case.kind == "nothing":
         return outcome == NOTHING
     # Outside the catalogue: not explained (ambiguous included), nothing visible, or a proxy
-    # that leaves a gap.
+    # whose DEM runs show that it does not explain the data.
     if outcome in (NOT_EXPLAINED, NOTHING) or outcome.startswith(AMBIGUOUS):
         return True
-    after = summary.get("gap_after")
-    return after is not None and float(after) > NOISE_GAP
+    return _confirmed(summary) is False
+
+
+def _confirmed(summary: Mapping[str, Any]) -> bool | None:
+    """Whether the DEM check confirmed the named effect (None when none was added)."""
+    if not summary.get("extended") and summary.get("dem_gap_after") is None:
+        return None
+    nan = math.nan
+    return dem_confirms(
+        float(summary.get("dem_gap_before", nan)),
+        float(summary.get("dem_gap_after", nan)),
+        float(summary.get("held_out_dem_gap_before", nan)),
+        float(summary.get("held_out_dem_gap_after", nan)),
+    )
 
 
 def confusion_matrix(rows: pd.DataFrame) -> pd.DataFrame:
@@ -390,6 +403,20 @@ def matrix_scores(rows: pd.DataFrame) -> dict[str, Any]:
     }
 
 
+def _confirmation_line(rows: pd.DataFrame) -> str:
+    """How often the DEM check confirmed right and wrong namings of catalogue effects."""
+    if "dem_confirmed" not in rows:
+        return "-"
+    named = rows[(rows["kind"] == "catalogue") & rows["dem_confirmed"].notna()]
+    right = named[named["correct"].astype(bool)]
+    wrong = named[~named["correct"].astype(bool)]
+
+    def count(part: pd.DataFrame) -> str:
+        return f"{int(part['dem_confirmed'].astype(bool).sum())} of {len(part)}"
+
+    return f"{count(right)} right namings, {count(wrong)} wrong ones"
+
+
 def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
     """The matrix report: scores, confusion matrix and one line per study."""
     scores = matrix_scores(rows)
@@ -410,7 +437,8 @@ def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
         f"{scores['null_studies']} (goal at most 5 %).",
         f"- Effect outside the catalogue: {pct(scores['outside_acceptable'])} of "
         f"{scores['outside_studies']} acceptable (nothing missing, not explained, or a proxy "
-        f"whose surrogate gap after stays above {NOISE_GAP:g}).",
+        "that the DEM runs do not confirm).",
+        f"- Named effects the DEM runs confirmed: {_confirmation_line(rows)}.",
         "",
         "Confusion matrix (studies per hidden effect and outcome):",
         "",

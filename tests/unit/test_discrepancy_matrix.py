@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 import yaml
 
+from demcal.discrepancy.before_after import dem_confirms
 from demcal.discrepancy.validation_matrix import (
     AMBIGUOUS,
     GAP_COLUMNS,
@@ -72,8 +73,13 @@ def test_outcomes_are_read_from_the_study(tmp_path):
     assert row["held_out_dem_gap_after"] == 0.9
     # The same answer for a material that hides nothing is a false alarm.
     assert study_outcome(none, tmp_path / "a")["correct"] is False
-    # A proxy for an effect outside the catalogue is acceptable only if a gap is left.
+    # A proxy for an effect outside the catalogue is acceptable only if the DEM runs do not
+    # confirm it: here they do (DEM gap 2.9 -> 1.1, held out 2.5 -> 0.9).
+    assert row["dem_confirmed"] is True
     assert study_outcome(softer, tmp_path / "a")["correct"] is False
+    write_study(tmp_path / "f", {**named, "held_out_dem_gap_after": 3.0}, truth, {})
+    proxy = study_outcome(softer, tmp_path / "f")
+    assert (proxy["dem_confirmed"], proxy["correct"]) == (False, True)
     write_study(
         tmp_path / "b",
         {**named, "winner": None, "magnitude": None},
@@ -162,11 +168,15 @@ def test_confusion_matrix_and_scores():
     )
     for column in (*GAP_COLUMNS, "magnitude_ratio"):
         full[column] = 1.0
+    # DEM check of the named effects: the right cohesion namings and the right rolling one
+    # confirmed, the wrong rolling naming of a cohesion study not.
+    full["dem_confirmed"] = [True, True, False, True] + [None] * 5 + [None, False]
     text = matrix_markdown(full, "Matrix", "python scripts/discrepancy_matrix.py")
     assert "Right effect named: 60 % of 5 studies" in text
     assert "False alarms with nothing hidden: 25 % of 4" in text
     assert "| cohesion | 2 | 1 | 0 | 0 | 0 |" in text
     assert "named or one of two the data could not tell apart: 80 %" in text
+    assert "Named effects the DEM runs confirmed: 3 of 3 right namings, 0 of 1 wrong ones" in text
 
 
 def test_placeholder_has_every_fitted_and_held_out_load():
@@ -176,3 +186,19 @@ def test_placeholder_has_every_fitted_and_held_out_load():
     }
     loads = [(c["normal_stress"], c["P"]) for c in placeholder_experiment(config)["shear_cell"]]
     assert loads == [(1068.0, 0.5), (2029.0, 0.5), (1500.0, 0.5)]
+
+
+@pytest.mark.parametrize(
+    ("gaps", "confirmed"),
+    [
+        ((2.0, 1.0, 1.5, 0.8), True),  # closer on fitted loads, held out within the noise
+        ((2.0, 1.0, 0.5, 0.9), True),  # held out a little worse but within the noise
+        ((2.0, 1.0, 2.0, 1.8), True),  # held out outside the noise but closer
+        ((2.0, 1.0, 0.5, 1.6), False),  # held out pushed out of the noise
+        ((2.0, 2.1, 1.0, 0.5), False),  # fitted loads no closer in DEM
+        ((2.0, 1.0, math.nan, math.nan), True),  # no held-out load
+        ((2.0, math.nan, 1.0, 0.5), False),  # no DEM run after
+    ],
+)
+def test_dem_check_confirms_an_effect_only_where_it_counts(gaps, confirmed):
+    assert dem_confirms(*gaps) is confirmed

@@ -131,6 +131,9 @@ def test_hidden_effect_is_named_and_gap_shrinks(studies, name):
     assert result["dem_gap_after"] < result["dem_gap_before"], result
     held = result["held_out_dem_gap_after"]
     assert held <= max(1.0, result["held_out_dem_gap_before"]), result
+    assert result["dem_confirmed"] is True
+    report = (studies[name] / "results" / "discrepancy" / "verification.md").read_text()
+    assert f"**The DEM runs confirm {name}**" in report
     truth = yaml.safe_load((studies[name] / "truth.yaml").read_text())["magnitude"]
     assert 0.4 * truth <= result["magnitude"] <= 2.0 * truth, (result, truth)
     ranking = pd.read_csv(studies[name] / "results" / "discrepancy" / "ranking.csv")
