@@ -65,6 +65,9 @@ class RankingResult:
         Observations or probe levels left out, and why.
     test : NamingTest or None
         The bootstrap tests of the naming decision (None when no candidate was scored).
+    ambiguous : tuple of str or None
+        The top candidate and the runner-up when an effect was found but the two could not be
+        told apart (nothing named for that reason), else None.
     """
 
     table: pd.DataFrame
@@ -74,6 +77,7 @@ class RankingResult:
     null_deviance: float
     notes: list[str] = field(default_factory=list)
     test: NamingTest | None = None
+    ambiguous: tuple[str, str] | None = None
 
 
 def rank(
@@ -200,8 +204,11 @@ def rank(
             int(settings["magnitude_points"]),
             int(settings["bootstrap_draws"]),
         )
+    ambiguous = None
     if winner_name is not None and test is not None:
-        winner_name = _tested_winner(winner_name, test, float(settings["alpha"]), obs, notes)
+        winner_name, ambiguous = _tested_winner(
+            winner_name, test, float(settings["alpha"]), obs, notes
+        )
     if winner_name is not None and len(obs) < null.n_free + 2:
         # A candidate adds one parameter: with N <= d + 1 it can fit every value exactly.
         notes.append(
@@ -217,7 +224,7 @@ def rank(
         table.loc[table["status"] == "scored", "named"], "named", "not significant"
     )
     winner = next((c for c in candidates if c.name == winner_name), None)
-    return RankingResult(table, winner, fits, null, null_weighted.deviance, notes, test)
+    return RankingResult(table, winner, fits, null, null_weighted.deviance, notes, test, ambiguous)
 
 
 def _mean_of_runs(runs: pd.DataFrame, run: str, count: int, obs: pd.DataFrame) -> np.ndarray:
@@ -229,15 +236,16 @@ def _mean_of_runs(runs: pd.DataFrame, run: str, count: int, obs: pd.DataFrame) -
 
 def _tested_winner(
     leader: str, test: NamingTest, alpha: float, obs: pd.DataFrame, notes: list[str]
-) -> str | None:
-    """The leader if both bootstrap tests reject at ``alpha``, else None (with a note why)."""
+) -> tuple[str | None, tuple[str, str] | None]:
+    """The leader if both bootstrap tests reject at ``alpha``, else None (with a note why);
+    and the top candidate with the runner-up when it is the runner-up test that fails."""
     if test.p_effect >= alpha:
         notes.append(
             f"{leader} leads, but is not named: noise alone gives as large an improvement "
             f"(p = {test.p_effect:.3g} >= {alpha:g}, {test.draws} data sets drawn under "
             "'nothing missing')"
         )
-        return None
+        return None, None
     if test.runner_up is not None and test.p_runner_up is not None:
         if test.p_runner_up >= alpha:
             where = ""
@@ -251,8 +259,8 @@ def _tested_winner(
                 f"by chance): their fits differ most in {where}; repeating that measurement or "
                 "measuring near it separates them best"
             )
-            return None
-    return leader
+            return None, (test.top, test.runner_up)
+    return leader, None
 
 
 def ranking_record(result: RankingResult) -> dict[str, Any]:
@@ -265,7 +273,7 @@ def ranking_record(result: RankingResult) -> dict[str, Any]:
         "null_deviance": result.null_deviance,
         "notes": result.notes,
         "p_effect": result.test.p_effect if result.test else None,
-        "top": result.test.top if result.test else None,
+        "ambiguous": list(result.ambiguous) if result.ambiguous else None,
         "runner_up": result.test.runner_up if result.test else None,
         "p_runner_up": result.test.p_runner_up if result.test else None,
         "ranking": [

@@ -278,7 +278,8 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
     summary = json.loads((out / "summary.json").read_text())
     truth = yaml.safe_load((work / "truth.yaml").read_text())
     ranking = json.loads((out / "ranking.json").read_text())
-    pair = _ambiguous_pair(summary, ranking)
+    # The top candidate and the runner-up when the naming could not tell them apart.
+    pair = tuple(sorted(ranking.get("ambiguous") or ()))
     if not summary["missing"]:
         outcome = NOTHING
     elif summary.get("winner"):
@@ -317,23 +318,6 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
     }
 
 
-def _ambiguous_pair(summary: Mapping[str, Any], ranking: Mapping[str, Any]) -> tuple[str, ...]:
-    """The two leading candidates, alphabetically, when the naming found an effect but could
-    not tell them apart (p_effect < alpha <= p_runner_up); else empty."""
-    if not summary.get("missing") or summary.get("winner") or not ranking.get("ran", True):
-        return ()
-    alpha = float(summary.get("alpha", 0.05))
-    # A record without "top": its ranking lists the candidates best first.
-    listed = ranking.get("ranking") or [{}]
-    top, runner_up = ranking.get("top") or listed[0].get("candidate"), ranking.get("runner_up")
-    p_effect, p_runner_up = ranking.get("p_effect"), ranking.get("p_runner_up")
-    if top is None or runner_up is None or p_effect is None or p_runner_up is None:
-        return ()
-    if float(p_effect) < alpha <= float(p_runner_up):
-        return tuple(sorted((str(top), str(runner_up))))
-    return ()
-
-
 def _correct(case: MatrixCase, outcome: str, summary: Mapping[str, Any]) -> bool:
     if case.kind == "catalogue":
         return outcome == case.hidden
@@ -348,7 +332,7 @@ def _correct(case: MatrixCase, outcome: str, summary: Mapping[str, Any]) -> bool
 
 def _confirmed(summary: Mapping[str, Any]) -> bool | None:
     """Whether the DEM check confirmed the named effect (None when none was added)."""
-    if not summary.get("extended") and summary.get("dem_gap_after") is None:
+    if "dem_gap_after" not in summary:
         return None
     nan = math.nan
     return dem_confirms(

@@ -95,20 +95,20 @@ def test_outcomes_are_read_from_the_study(tmp_path):
         tmp_path / "d",
         {**named, "winner": None, "magnitude": None, "alpha": 0.05},
         truth,
-        {"ran": True, "p_effect": 0.001, "top": "rolling", "runner_up": "cohesion",
-         "p_runner_up": 0.145},
+        {"ran": True, "p_effect": 0.001, "runner_up": "cohesion", "p_runner_up": 0.145,
+         "ambiguous": ["rolling", "cohesion"]},
     )  # fmt: skip
     row = study_outcome(cohesion, tmp_path / "d")
     assert row["outcome"] == f"{AMBIGUOUS}: cohesion / rolling"
     assert (row["correct"], row["shortlisted"]) == (False, True)
     assert study_outcome(softer, tmp_path / "d")["correct"] is True
-    # The same p-values with a clear runner-up would have named the top one: no pair.
+    # Not named because noise alone explains as much: no pair.
     write_study(
         tmp_path / "e",
         {**named, "winner": None, "magnitude": None, "alpha": 0.05},
         truth,
-        {"ran": True, "p_effect": 0.2, "top": "rolling", "runner_up": "cohesion",
-         "p_runner_up": 0.5},
+        {"ran": True, "p_effect": 0.2, "runner_up": "cohesion", "p_runner_up": 0.5,
+         "ambiguous": None},
     )  # fmt: skip
     row = study_outcome(cohesion, tmp_path / "e")
     assert (row["outcome"], row["shortlisted"]) == (NOT_EXPLAINED, False)

@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from demcal.core.experiments import Experiment, MeasuredCondition
@@ -10,7 +11,9 @@ from demcal.discrepancy.best_fit import ParameterBox
 from demcal.discrepancy.effect_response import EffectResponse, response_signature
 from demcal.discrepancy.find import find
 from demcal.discrepancy.observations import SurrogateModel, observation_table
+from demcal.discrepancy.probe_ranking import _tested_winner
 from demcal.discrepancy.ranking import (
+    NamingTest,
     fit_candidate,
     naming_test,
     null_fit,
@@ -261,3 +264,18 @@ def test_naming_reports_two_candidates_that_cannot_be_told_apart():
     assert all(t.p_effect < 0.05 for t in tests)
     ambiguous = [t for t in tests if t.p_runner_up >= 0.05]
     assert len(ambiguous) >= 36, [t.p_runner_up for t in tests]
+
+
+def test_naming_decision_records_the_pair_it_cannot_tell_apart():
+    obs = pd.DataFrame({"observable": ["mu_psh"], "normal_stress": [1068.0], "P": [0.5]})
+    notes: list[str] = []
+    # The runner-up fits as well: not named, and the two are the ambiguous pair.
+    both = NamingTest("rolling", 0.001, "cohesion", 0.145, 0, 1000)
+    assert _tested_winner("rolling", both, 0.05, obs, notes) == (None, ("rolling", "cohesion"))
+    assert "rolling and cohesion cannot be told apart" in notes[-1]
+    # Noise alone explains as much: not named, and no pair.
+    noise = NamingTest("rolling", 0.2, "cohesion", 0.5, 0, 1000)
+    assert _tested_winner("rolling", noise, 0.05, obs, notes) == (None, None)
+    # Both tests reject: named.
+    clear = NamingTest("rolling", 0.001, "cohesion", 0.01, 0, 1000)
+    assert _tested_winner("rolling", clear, 0.05, obs, notes) == ("rolling", None)
