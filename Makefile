@@ -10,7 +10,7 @@ ENGINE_SOURCES := $(shell find dem_engine/src dem_engine/CMakeLists.txt -type f 
 CORES ?= all
 SNAKEMAKE_ARGS ?=
 
-.PHONY: setup sysdeps engine run test lint bench convergence discrepancy-matrix docs clean
+.PHONY: setup sysdeps engine run test lint bench convergence discrepancy-matrix sequential-comparison docs clean
 
 setup: $(PY_STAMP) sysdeps engine
 
@@ -63,6 +63,13 @@ MATRIX_ARGS ?= --truths 5
 discrepancy-matrix: setup
 	source $(VENV)/bin/activate && python scripts/discrepancy_matrix.py --profile $(MATRIX_PROFILE) \
 		--out results/matrix/$(basename $(notdir $(MATRIX_PROFILE))) $(MATRIX_ARGS)
+
+# Sequential against one-shot calibration on two synthetic materials (LIGGGHTS truths, quick
+# scale; resumable): docs/sequential.md.
+COMPARISON_ARGS ?= --budgets 44 72 100
+sequential-comparison: setup
+	source $(VENV)/bin/activate && python scripts/sequential_comparison.py \
+		--out results/sequential_comparison $(COMPARISON_ARGS)
 
 # The configuration reference, generated from the schema (tests/unit/test_docs.py checks it).
 docs: $(PY_STAMP)

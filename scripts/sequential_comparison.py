@@ -1,0 +1,213 @@
+"""Compare sequential and one-shot calibration on synthetic materials with a known truth.
+
+For every truth specification (--spec; default the synthetic reference material and one with
+drawn parameters) the truth is run --replicates times on --truth-engine (default LIGGGHTS
+3.8 when installed) at the scale of --profile, with the noise of the hidden-effect studies
+(3 % on friction values and the angle of repose, 1 % on bulk density), and written as the
+measurements. Then, in directories of their own under OUT/<material>/:
+
+* ``sequential/``: the study of --profile with --sequential on top (rounds, stopping rule,
+  budget the largest of --budgets); every round is one point (its verification included);
+* ``oneshot_<B>/``: for each budget B of --budgets, a one-shot Sobol' design of as many sets
+  as B allows after one verification, screened and verified like the default study. The Sobol'
+  designs of the budgets are nested, so the DEM runs of a smaller budget are reused by the next.
+
+Writes OUT/comparison.csv, OUT/comparison.md (the table, with the command) and
+OUT/comparison.png (error against DEM runs for both designs). Resumable: finished studies are
+read back, not run again.
+
+Usage: python scripts/sequential_comparison.py --out results/sequential_comparison \\
+    [--profile config/config.yaml] [--sequential config/sequential.yaml] \\
+    [--budgets 44 72 100] [--spec FILE ...] [--truth-engine "liggghts -in {deck}"]
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+import yaml
+
+from demcal.core.config import validate_config
+from demcal.discrepancy.candidates import deep_merge
+from demcal.discrepancy.synthetic import (
+    NOISE,
+    hidden_effect_bulk,
+    replicate_record,
+    write_truth,
+)
+from demcal.discrepancy.truths import draw_truth, load_truth_spec
+from demcal.engine_io.run import installed_liggghts
+from demcal.sequential.comparison import (
+    comparison_figure,
+    comparison_markdown,
+    oneshot_row,
+    oneshot_sets,
+    sequential_rows,
+)
+from demcal.sequential.rounds import design_ranges
+
+ROOT = Path(__file__).resolve().parents[1]
+TRUTHS = ROOT / "config" / "experiments" / "truth"
+DEFAULT_SPECS = [TRUTHS / "synthetic_reference.yaml", TRUTHS / "synthetic_drawn.yaml"]
+EXPERIMENT = "config/experiments/measured.yaml"
+
+
+def snakemake(work: Path, cores: int, log: Path, *args: str) -> None:
+    """Run Snakemake in a study directory; raise with the log's tail when it fails."""
+    cmd = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        *args,
+        "--snakefile",
+        str(ROOT / "Snakefile"),
+        "--directory",
+        str(work),
+        "--configfile",
+        str(work / "config" / "config.yaml"),
+        "--cores",
+        str(cores),
+        "--rerun-incomplete",
+    ]
+    with log.open("a") as handle:
+        res = subprocess.run(cmd, cwd=work, stdout=handle, stderr=subprocess.STDOUT, check=False)
+    if res.returncode != 0:
+        tail = "\n".join(log.read_text().splitlines()[-30:])
+        raise RuntimeError(f"snakemake {' '.join(args)} in {work} failed ({log}):\n{tail}")
+
+
+def write_study_config(work: Path, config: dict[str, Any], experiment: Path) -> dict[str, Any]:
+    """Write a study directory's configuration and measurements; return it validated."""
+    (work / "config" / "experiments").mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(experiment, work / EXPERIMENT)
+    config = {**config, "experiment": EXPERIMENT}
+    path = work / "config" / "config.yaml"
+    path.write_text(yaml.safe_dump(config, sort_keys=False))
+    return validate_config(copy.deepcopy(config), str(path))
+
+
+def make_measurements(
+    spec: Path, config: dict[str, Any], mdir: Path, args: argparse.Namespace
+) -> tuple[Path, dict[str, float]]:
+    """The material's truth and measurements (kept when they exist)."""
+    experiment, truth_file = mdir / "measured.yaml", mdir / "truth.yaml"
+    if not (experiment.is_file() and truth_file.is_file()):
+        validated = validate_config(copy.deepcopy(config), str(spec))
+        truth = draw_truth(load_truth_spec(spec), validated, args.truth_seed, str(spec))
+        bulk = hidden_effect_bulk(
+            truth,
+            validated,
+            mdir / "truth_runs",
+            tests=("shear_cell", "angle_of_repose"),
+            workers=args.cores,
+            replicates=args.replicates,
+            engine_command=args.truth_engine,
+        )
+        levels = ", ".join(f"{k} {v:.1%}" for k, v in NOISE.items())
+        record = replicate_record(
+            bulk,
+            truth.material,
+            NOISE,
+            args.truth_seed,
+            f"`{args.truth_engine or validated['engine']['command']}` at the truth "
+            f"({validated['profile']} profile, drawn with seed {args.truth_seed}), mean of "
+            f"{args.replicates} runs, noise {levels}",
+        )
+        experiment.write_text(yaml.safe_dump(record, sort_keys=False))
+        write_truth(mdir, truth)
+        shutil.rmtree(mdir / "truth_runs")
+    truth = yaml.safe_load(truth_file.read_text())
+    return experiment, {k: float(v) for k, v in truth["parameters"].items()}
+
+
+def reuse_cases(source: Path, target: Path) -> None:
+    """Copy the finished DEM cases of a smaller nested design, newer than the target's design.
+
+    The copies are stamped in the order of the rules (deck, then run status, then bulk values)
+    so that Snakemake sees them as made from the target's design table, not as outdated.
+    """
+    cases = source / "results" / "cases"
+    if not cases.is_dir():
+        return
+    shutil.copytree(cases, target / "results" / "cases", dirs_exist_ok=True)
+    now = time.time()
+    for path in (target / "results" / "cases").rglob("*"):
+        if path.is_file():
+            later = {"status.json": 1.0, "bulk.csv": 2.0}.get(path.name, 0.0)
+            os.utime(path, (now + later, now + later))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", required=True, type=Path, help="directory of the comparison")
+    parser.add_argument("--profile", type=Path, default=ROOT / "config" / "config.yaml")
+    parser.add_argument("--sequential", type=Path, default=ROOT / "config" / "sequential.yaml")
+    parser.add_argument("--budgets", type=int, nargs="+", default=[44, 72, 100])
+    parser.add_argument("--spec", type=Path, nargs="*", help="truth specifications")
+    parser.add_argument("--truth-seed", type=int, default=1, help="seed of truth draw and noise")
+    parser.add_argument("--truth-engine", default=installed_liggghts())
+    parser.add_argument("--replicates", type=int, default=3, help="truth runs per test")
+    parser.add_argument("--cores", type=int, default=2)
+    args = parser.parse_args()
+    budgets = sorted(set(args.budgets))
+    base = deep_merge(
+        yaml.safe_load(args.profile.read_text()) or {},
+        yaml.safe_load(args.sequential.read_text()) or {},
+    )
+    base.pop("experiment", None)
+    seq_config = deep_merge(base, {"sequential": {"budget": budgets[-1]}})
+    args.out.mkdir(parents=True, exist_ok=True)
+    command = "python " + " ".join(shlex.quote(a) for a in sys.argv)
+    rows = []
+    for spec in args.spec or DEFAULT_SPECS:
+        mdir = args.out / spec.stem
+        mdir.mkdir(parents=True, exist_ok=True)
+        experiment, truth = make_measurements(spec, base, mdir, args)
+        material = yaml.safe_load(experiment.read_text())["material"]
+        work = mdir / "sequential"
+        config = write_study_config(work, seq_config, experiment)
+        ranges = design_ranges(config)
+        tol = float(config["screening"]["tolerance"])
+        snakemake(work, args.cores, mdir / "sequential.log", "sequential")
+        rows += sequential_rows(work, material, truth, ranges, tol)
+        previous = None
+        for budget in budgets:
+            sets = oneshot_sets(config, budget)
+            work = mdir / f"oneshot_{budget}"
+            one = deep_merge(base, {"sequential": {"enabled": False}})
+            one["design"] = {**one["design"], "kind": "sobol", "n": sets}
+            one_config = write_study_config(work, one, experiment)
+            if not (work / "results" / "verification" / "verification.csv").is_file():
+                log = mdir / f"oneshot_{budget}.log"
+                snakemake(work, args.cores, log, "results/design/cases.csv")
+                if previous is not None:
+                    reuse_cases(previous, work)
+                snakemake(
+                    work,
+                    args.cores,
+                    log,
+                    "results/verification/verification.csv",
+                    "--rerun-triggers",
+                    "mtime",
+                )
+            rows.append(oneshot_row(work, material, one_config, truth))
+            previous = work
+        table = pd.DataFrame(rows)
+        table.to_csv(args.out / "comparison.csv", index=False, float_format="%.6g")
+        (args.out / "comparison.md").write_text(comparison_markdown(table, tol, command))
+        comparison_figure(table, tol, args.out / "comparison.png")
+        print(f"{material}: done", flush=True)
+
+
+if __name__ == "__main__":
+    main()
