@@ -20,6 +20,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+import numpy as np
 import pandas as pd
 
 from demcal.sequential.rounds import design_ranges, runs_per_set, verification_runs
@@ -143,8 +144,9 @@ def comparison_row(
     -------
     dict
         ``material``, ``design``, ``label``, ``runs``, ``error_<parameter>``,
-        ``max_parameter_error``, ``worst_bulk_deviation``, ``worst_bulk_value`` and ``within``
-        (every measured value within ``tolerance`` by DEM).
+        ``max_parameter_error``, ``worst_bulk_deviation``, ``worst_bulk_value``,
+        ``median_bulk_deviation``, ``share_within`` (the fraction of measured values within
+        ``tolerance`` by DEM) and ``within`` (every one of them).
     """
     errors = parameter_errors(identified, truth, ranges)
     worst = max(deviations, key=lambda k: deviations[k]) if deviations else ""
@@ -154,6 +156,9 @@ def comparison_row(
     row["max_parameter_error"] = max(finite) if len(finite) == len(errors) else math.nan
     row["worst_bulk_deviation"] = deviations[worst] if worst else math.nan
     row["worst_bulk_value"] = worst
+    values = sorted(deviations.values())
+    row["median_bulk_deviation"] = float(np.median(values)) if values else math.nan
+    row["share_within"] = sum(v <= tolerance for v in values) / len(values) if values else math.nan
     row["within"] = bool(deviations) and all(v <= tolerance for v in deviations.values())
     return row
 
@@ -238,13 +243,19 @@ def comparison_markdown(table: pd.DataFrame, tolerance: float, command: str) -> 
         f"Command: `{command}`",
         "",
         "Parameter errors are |identified mean - truth| / design range; bulk deviations are "
-        "|1 - DEM / measured| of the verification runs (the worst measured value is named). "
-        f"`within`: every measured value within {tolerance:.0%} by DEM.",
+        "|1 - DEM / measured| of the verification runs (the worst measured value is named; "
+        f"`share_within`: the fraction within {tolerance:.0%}). `within`: every measured value "
+        f"within {tolerance:.0%} by DEM.",
         "",
     ]
     shown = table.copy()
     for column in shown.columns:
-        if column.startswith("error_") or column in ("max_parameter_error", "worst_bulk_deviation"):
+        if column.startswith("error_") or column in (
+            "max_parameter_error",
+            "worst_bulk_deviation",
+            "median_bulk_deviation",
+            "share_within",
+        ):
             shown[column] = shown[column].map(lambda v: "-" if pd.isna(v) else f"{v:.3f}")
     lines.append(shown.to_markdown(index=False, disable_numparse=True))
     lines.append("")

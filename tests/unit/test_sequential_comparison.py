@@ -82,6 +82,8 @@ def test_rows_name_the_worst_value_and_judge_the_tolerance():
     )
     assert row["worst_bulk_value"] == "aor" and row["worst_bulk_deviation"] == 0.062
     assert row["max_parameter_error"] == pytest.approx(0.3)
+    assert row["median_bulk_deviation"] == 0.031
+    assert row["share_within"] == pytest.approx(2 / 3)
     assert not row["within"]
     deviations["aor"] = 0.049
     assert comparison_row(
