@@ -45,6 +45,7 @@ test: setup
 
 lint: setup
 	$(VENV)/bin/ruff check demcal scripts tests
+	$(VENV)/bin/ruff format --check demcal scripts tests
 	source $(VENV)/bin/activate && snakemake --lint
 
 bench: setup

@@ -41,17 +41,31 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", type=int, default=1000, help="mutated decks (default 1000)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the mutations (default 0)")
-    parser.add_argument("--timeout", type=float, default=20.0,
-                        help="time limit per case in seconds (default 20)")
-    parser.add_argument("--max-steps", type=int, default=20,
-                        help="cap on the step count of every `run` (default 20)")
+    parser.add_argument(
+        "--timeout", type=float, default=20.0, help="time limit per case in seconds (default 20)"
+    )
+    parser.add_argument(
+        "--max-steps",
+        type=int,
+        default=20,
+        help="cap on the step count of every `run` (default 20)",
+    )
     parser.add_argument("--jobs", type=int, default=2, help="engine runs at a time (default 2)")
-    parser.add_argument("--out", type=Path, default=Path("fuzz_failures"),
-                        help="directory for failing cases (default fuzz_failures)")
-    parser.add_argument("--engine", default=None,
-                        help="engine command (default: the venv's dem_engine)")
-    parser.add_argument("--work", type=Path, default=None,
-                        help="work directory (default: a temporary one, removed at the end)")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("fuzz_failures"),
+        help="directory for failing cases (default fuzz_failures)",
+    )
+    parser.add_argument(
+        "--engine", default=None, help="engine command (default: the venv's dem_engine)"
+    )
+    parser.add_argument(
+        "--work",
+        type=Path,
+        default=None,
+        help="work directory (default: a temporary one, removed at the end)",
+    )
     args = parser.parse_args(argv)
 
     engine = shlex.split(args.engine) if args.engine else [default_engine()]
@@ -66,16 +80,29 @@ def main(argv: list[str] | None = None) -> int:
 
     with tempfile.TemporaryDirectory(prefix="fuzz_decks_") as tmp:
         work = args.work or Path(tmp)
-        outcomes = fuzz(args.cases, args.seed, work, engine, args.timeout, args.max_steps,
-                        args.jobs, args.out, progress)
+        outcomes = fuzz(
+            args.cases,
+            args.seed,
+            work,
+            engine,
+            args.timeout,
+            args.max_steps,
+            args.jobs,
+            args.out,
+            progress,
+        )
     wall = time.monotonic() - start
     print(summary_table(outcomes))
-    print(f"{len(outcomes)} cases, seed {args.seed}, max steps {args.max_steps}, "
-          f"timeout {args.timeout:g} s, {args.jobs} jobs, wall time {wall:.0f} s")
+    print(
+        f"{len(outcomes)} cases, seed {args.seed}, max steps {args.max_steps}, "
+        f"timeout {args.timeout:g} s, {args.jobs} jobs, wall time {wall:.0f} s"
+    )
     bad = failures(outcomes)
     for o in bad[:50]:
-        print(f"{o.kind}: case {o.index} ({o.base}) exit {o.returncode}: {'; '.join(o.mutations)}"
-              f"\n    {o.last_error or o.stderr_tail.strip()[-300:]}")
+        print(
+            f"{o.kind}: case {o.index} ({o.base}) exit {o.returncode}: {'; '.join(o.mutations)}"
+            f"\n    {o.last_error or o.stderr_tail.strip()[-300:]}"
+        )
     if bad:
         print(f"{len(bad)} failing cases kept under {args.out}/")
     return 1 if bad else 0

@@ -1,2 +1,1 @@
-"""Industrial applications of an identified parameter set.
-"""
+"""Industrial applications of an identified parameter set."""

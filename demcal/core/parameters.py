@@ -135,9 +135,7 @@ PARAMETERS: dict[str, Parameter] = {
         Parameter("density", "rho_p", "kg/m^3", Interval(0.0, _INF, False, False)),
         Parameter("cohesionEnergyDensity", "k_coh", "J/m^3", Interval(0.0, _INF, True, False)),
         Parameter("wallFriction", "mu_w", "-", Interval(0.0, _INF, True, False)),
-        Parameter(
-            "youngsModulus", "Y", "Pa", Interval(0.0, MAX_YOUNGS_MODULUS, False, True)
-        ),
+        Parameter("youngsModulus", "Y", "Pa", Interval(0.0, MAX_YOUNGS_MODULUS, False, True)),
         Parameter("poissonsRatio", "nu", "-", Interval(0.0, 0.5, False, False)),
         Parameter("dCylDp", "D/d_p", "-", Interval(0.0, _INF, False, False)),
     )

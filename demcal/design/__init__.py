@@ -1,2 +1,1 @@
-"""Design of DEM cases: the parameter design table and its expansion into one case per run.
-"""
+"""Design of DEM cases: the parameter design table and its expansion into one case per run."""

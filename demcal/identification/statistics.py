@@ -24,7 +24,6 @@ VALID_GROUP = "valid sets"
 """First index level of the two count rows of Table 5 (``number`` and ``percent``)."""
 
 
-
 def _check_columns(valid: pd.DataFrame, parameters: Sequence[str], what: str) -> None:
     missing = [p for p in parameters if p not in valid.columns]
     if missing:

@@ -75,9 +75,7 @@ class Outcome:
     extra: dict[str, Any] = field(default_factory=dict)
 
 
-def classify(
-    returncode: int | None, stderr: str, directory: Path | None = None
-) -> tuple[str, str]:
+def classify(returncode: int | None, stderr: str, directory: Path | None = None) -> tuple[str, str]:
     """The outcome kind of one engine run and its last ``ERROR:`` line.
 
     Parameters
@@ -247,8 +245,9 @@ def summary_table(outcomes: Sequence[Outcome]) -> str:
         row = [kind, *(str(counts[(b, kind)]) for b in bases)]
         row.append(str(sum(counts[(b, kind)] for b in bases)))
         rows.append(row)
-    rows.append(["all", *(str(sum(o.base == b for o in outcomes)) for b in bases),
-                 str(len(outcomes))])
+    rows.append(
+        ["all", *(str(sum(o.base == b for o in outcomes)) for b in bases), str(len(outcomes))]
+    )
     widths = [max(len(r[k]) for r in rows) for k in range(len(header))]
     lines = []
     for n, r in enumerate(rows):

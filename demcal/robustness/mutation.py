@@ -25,15 +25,56 @@ RUN_LINE = re.compile(r"^(\s*run\s+)(\d+)(?=\s|$)")
 
 #: What a number may be replaced by.
 NUMBER_REPLACEMENTS = (
-    "0", "-{}", "1e300", "-1e300", "1e200", "1e20", "1e-300", "nan", "inf", "-inf", "abc",
-    "2147483648", "9223372036854775807",
+    "0",
+    "-{}",
+    "1e300",
+    "-1e300",
+    "1e200",
+    "1e20",
+    "1e-300",
+    "nan",
+    "inf",
+    "-inf",
+    "abc",
+    "2147483648",
+    "9223372036854775807",
 )
 #: Tokens a mutation may insert besides the deck's own words; no `jump`/`next`/`label`,
 #: which could loop a valid deck for ever.
 EXTRA_TOKENS = (
-    "0", "-1", "1e300", "nan", "inf", "-inf", "&", "#", "$", "${", "$(", ")", "'", '"', '"""',
-    "*", "v_", "f_", "c_", "all", "NULL", "yes", "no", "upto", "every", "region", "type",
-    "2147483648", "9223372036854775808", "-2147483649", "1e19", "0x10", "",
+    "0",
+    "-1",
+    "1e300",
+    "nan",
+    "inf",
+    "-inf",
+    "&",
+    "#",
+    "$",
+    "${",
+    "$(",
+    ")",
+    "'",
+    '"',
+    '"""',
+    "*",
+    "v_",
+    "f_",
+    "c_",
+    "all",
+    "NULL",
+    "yes",
+    "no",
+    "upto",
+    "every",
+    "region",
+    "type",
+    "2147483648",
+    "9223372036854775808",
+    "-2147483649",
+    "1e19",
+    "0x10",
+    "",
 )
 
 
@@ -136,9 +177,7 @@ def cap_runs(text: str, max_steps: int) -> str:
     return "\n".join(cap(line) for line in text.split("\n"))
 
 
-def make_cases(
-    bases: Sequence[BaseDeck], cases: int, seed: int, max_steps: int
-) -> list[FuzzCase]:
+def make_cases(bases: Sequence[BaseDeck], cases: int, seed: int, max_steps: int) -> list[FuzzCase]:
     """Generate ``cases`` seeded mutations of the base decks (round robin over the decks).
 
     Parameters

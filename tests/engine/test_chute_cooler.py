@@ -210,6 +210,7 @@ def test_paraview_files(finished):
         front = setup.box_front_x0 + setup.row_offset(step * setup.timestep)
         assert pyvista.read(path).bounds[1] == pytest.approx(front, abs=1e-9)
     last = pyvista.read(particles[-1])
-    assert last.n_points > 0.5 * json.loads((out / "segregation_index.json").read_text())[
-        "particles_fed_expected"
-    ]
+    assert (
+        last.n_points
+        > 0.5 * json.loads((out / "segregation_index.json").read_text())["particles_fed_expected"]
+    )

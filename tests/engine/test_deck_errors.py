@@ -37,7 +37,10 @@ def run_deck(tmp_path, text, timeout=30):
     (tmp_path / "in.deck").write_text(text)
     return subprocess.run(
         [engine_path(), "-in", "in.deck", "-log", "none", "-noprogress"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=timeout,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
         env=dict(os.environ, OMP_NUM_THREADS="1"),
     )
 
@@ -61,22 +64,34 @@ CORRUPTIONS = [
     ("timestep 1e-5", "timestep", "timestep", "usage"),
     ("pair_coeff * *", "pair_coeff * * 3", "pair_coeff", "pair_coeff"),
     ("pair_style gran model hertz", "pair_style gran model hooke", "pair_style", "hooke"),
-    ("fix grav all gravity 9.81 vector 0 0 -1", "fix grav all gravity 9.81 vector 0 0",
-     "fix", "gravity"),
+    (
+        "fix grav all gravity 9.81 vector 0 0 -1",
+        "fix grav all gravity 9.81 vector 0 0",
+        "fix",
+        "gravity",
+    ),
     ("fix integr all nve/sphere", "fix integr all nve/ellipsoid", "fix", "nve/ellipsoid"),
     ("fix integr all nve/sphere", "fix integr nogroup nve/sphere", "fix", "nogroup"),
     ("region ins block", "region ins sphere", "region", "sphere"),
     ("thermo 50", "thermo fifty", "thermo", "fifty"),
-    ("thermo_style custom step atoms ke v_z", "thermo_style custom step atoms ke v_nope",
-     "run", "nope"),
+    (
+        "thermo_style custom step atoms ke v_z",
+        "thermo_style custom step atoms ke v_nope",
+        "run",
+        "nope",
+    ),
     ("variable z equal xcm(all,z)", "variable z equal xcm(all,z", "run", "z"),
     ("run 100", "run 100 sometimes", "run", "sometimes"),
     ("run 100", "shell rm -rf /", "shell", "shell"),
     ("run 100", "include missing_file.in", "include", "missing_file.in"),
     ("run 100", "frobnicate 3", "frobnicate", "unknown"),
     ("peratomtype 5000000.0 5000000.0", "peratomtype 5000000.0", "run", "youngsModulus"),
-    ("coefficientRestitution peratomtypepair 2 0.6 0.6 0.6 0.6",
-     "coefficientRestitution peratomtypepair 2 1.6 1.6 1.6 1.6", "run", "coefficientRestitution"),
+    (
+        "coefficientRestitution peratomtypepair 2 0.6 0.6 0.6 0.6",
+        "coefficientRestitution peratomtypepair 2 1.6 1.6 1.6 1.6",
+        "run",
+        "coefficientRestitution",
+    ),
 ]
 
 

@@ -34,8 +34,16 @@ SEED = 20240601
 
 def test_fuzzed_tiny_decks_are_run_or_rejected_with_file_and_line(tmp_path: Path) -> None:
     start = time.monotonic()
-    outcomes = fuzz(CASES, SEED, tmp_path / "work", [engine_path()], timeout=20.0,
-                    max_steps=20, jobs=2, out_dir=tmp_path / "failures")
+    outcomes = fuzz(
+        CASES,
+        SEED,
+        tmp_path / "work",
+        [engine_path()],
+        timeout=20.0,
+        max_steps=20,
+        jobs=2,
+        out_dir=tmp_path / "failures",
+    )
     table = summary_table(outcomes)
     bad = failures(outcomes)
     detail = "\n".join(

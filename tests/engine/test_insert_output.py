@@ -275,6 +275,7 @@ def test_print_and_ave_time_files(tmp_path: Path) -> None:
 
 def test_dump_custom_and_vtk_agree_and_open_in_pyvista(tmp_path: Path) -> None:
     import pyvista as pv
+
     deck = (
         header()
         + TEMPLATE

@@ -192,8 +192,11 @@ def test_restitution_range_follows_liggghts_bounds(low, high, valid):
 
 
 def test_unknown_name_without_a_close_match_lists_the_known_names():
-    with pytest.raises(ConfigError, match=r"design\.choices\.colour: unknown contact parameter "
-                       r"\(known: coefficientFriction, .*dCylDp\)"):
+    with pytest.raises(
+        ConfigError,
+        match=r"design\.choices\.colour: unknown contact parameter "
+        r"\(known: coefficientFriction, .*dCylDp\)",
+    ):
         validate_config({"design": {"choices": {"colour": [1.0, 2.0]}}}, "x.yaml")
 
 

@@ -196,9 +196,7 @@ def test_box_plot_shows_each_parameter_over_its_maximum(tmp_path: Path) -> None:
     # One box per parameter at x = 1..4: quartiles and median of the column over its maximum.
     boxes = [line for line in ax.lines if len(line.get_xdata()) == 5]
     medians = [
-        line
-        for line in ax.lines
-        if len(line.get_xdata()) == 2 and np.ptp(line.get_xdata()) > 0.4
+        line for line in ax.lines if len(line.get_xdata()) == 2 and np.ptp(line.get_xdata()) > 0.4
     ]
     assert len(boxes) == len(medians) == 4
     for k, name in enumerate(valid.columns):

@@ -197,7 +197,6 @@ def test_stress_series_by_hand() -> None:
     assert out["mu"] == pytest.approx(6.0 / normal, rel=1e-12)
 
 
-
 def test_bulk_values_recovered_per_cycle() -> None:
     table = synthetic_run(CYCLES, seed=1)
     got = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)

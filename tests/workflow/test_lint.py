@@ -1,4 +1,5 @@
-"""Code style gates: ruff on the Python code and Snakemake's own linter on the workflow."""
+"""Code style gates: ruff (lint and format) on the Python code and Snakemake's own linter on
+the workflow."""
 
 import subprocess
 import sys
@@ -11,7 +12,21 @@ BIN = Path(sys.executable).parent
 def test_ruff_clean():
     res = subprocess.run(
         [str(BIN / "ruff"), "check", "demcal", "scripts", "tests"],
-        cwd=ROOT, capture_output=True, text=True, timeout=120,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert res.returncode == 0, res.stdout + res.stderr
+
+
+def test_ruff_format_clean():
+    res = subprocess.run(
+        [str(BIN / "ruff"), "format", "--check", "demcal", "scripts", "tests"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
     assert res.returncode == 0, res.stdout + res.stderr
 
@@ -19,7 +34,10 @@ def test_ruff_clean():
 def test_snakemake_lint_clean():
     res = subprocess.run(
         [sys.executable, "-m", "snakemake", "--lint"],
-        cwd=ROOT, capture_output=True, text=True, timeout=300,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert res.returncode == 0, res.stdout + res.stderr
     assert "Congratulations" in res.stdout + res.stderr

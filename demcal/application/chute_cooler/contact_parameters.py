@@ -88,4 +88,3 @@ def application_parameters(
             raise SetupError(f"configuration: '{_SECTION}.wall_friction': {problem}")
         out["wallFriction"] = wall
     return out
-

@@ -1,2 +1,1 @@
-"""Virtual lifted-cylinder angle of repose: set-up and the slice / convex-hull readout.
-"""
+"""Virtual lifted-cylinder angle of repose: set-up and the slice / convex-hull readout."""
