@@ -28,7 +28,6 @@ import copy
 import os
 import shlex
 import shutil
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -38,6 +37,7 @@ import pandas as pd
 import yaml
 
 from demcal.core.config import validate_config
+from demcal.core.snakemake_run import run_snakemake
 from demcal.discrepancy.candidates import deep_merge
 from demcal.discrepancy.synthetic import (
     NOISE,
@@ -60,30 +60,6 @@ ROOT = Path(__file__).resolve().parents[1]
 TRUTHS = ROOT / "config" / "experiments" / "truth"
 DEFAULT_SPECS = [TRUTHS / "synthetic_reference.yaml", TRUTHS / "synthetic_drawn.yaml"]
 EXPERIMENT = "config/experiments/measured.yaml"
-
-
-def snakemake(work: Path, cores: int, log: Path, *args: str) -> None:
-    """Run Snakemake in a study directory; raise with the log's tail when it fails."""
-    cmd = [
-        sys.executable,
-        "-m",
-        "snakemake",
-        *args,
-        "--snakefile",
-        str(ROOT / "Snakefile"),
-        "--directory",
-        str(work),
-        "--configfile",
-        str(work / "config" / "config.yaml"),
-        "--cores",
-        str(cores),
-        "--rerun-incomplete",
-    ]
-    with log.open("a") as handle:
-        res = subprocess.run(cmd, cwd=work, stdout=handle, stderr=subprocess.STDOUT, check=False)
-    if res.returncode != 0:
-        tail = "\n".join(log.read_text().splitlines()[-30:])
-        raise RuntimeError(f"snakemake {' '.join(args)} in {work} failed ({log}):\n{tail}")
 
 
 def write_study_config(work: Path, config: dict[str, Any], experiment: Path) -> dict[str, Any]:
@@ -178,7 +154,7 @@ def main() -> None:
         config = write_study_config(work, seq_config, experiment)
         ranges = design_ranges(config)
         tol = float(config["screening"]["tolerance"])
-        snakemake(work, args.cores, mdir / "sequential.log", "sequential")
+        run_snakemake(work, args.cores, mdir / "sequential.log", "sequential")
         rows += sequential_rows(work, material, truth, ranges, tol)
         previous = None
         for budget in budgets:
@@ -189,10 +165,10 @@ def main() -> None:
             one_config = write_study_config(work, one, experiment)
             if not (work / "results" / "verification" / "verification.csv").is_file():
                 log = mdir / f"oneshot_{budget}.log"
-                snakemake(work, args.cores, log, "results/design/cases.csv")
+                run_snakemake(work, args.cores, log, "results/design/cases.csv")
                 if previous is not None:
                     reuse_cases(previous, work)
-                snakemake(
+                run_snakemake(
                     work,
                     args.cores,
                     log,

@@ -21,8 +21,6 @@ import copy
 import json
 import math
 import shutil
-import subprocess
-import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -32,6 +30,7 @@ import pandas as pd
 import yaml
 
 from demcal.core.config import validate_config
+from demcal.core.snakemake_run import run_snakemake
 from demcal.discrepancy.before_after import dem_confirms
 from demcal.discrepancy.report import markdown_table
 from demcal.discrepancy.synthetic import (
@@ -152,33 +151,6 @@ def matrix_cases(specs: Sequence[str | Path], truths: int, first_seed: int) -> l
     ]
 
 
-def _snakemake(work: Path, cores: int, log: Path, *targets: str) -> None:
-    root = Path(__file__).resolve().parents[2]
-    cmd = [
-        sys.executable,
-        "-m",
-        "snakemake",
-        *targets,
-        "--snakefile",
-        str(root / "Snakefile"),
-        "--directory",
-        str(work),
-        "--configfile",
-        str(work / "config" / "config.yaml"),
-        "--cores",
-        str(cores),
-        # Rendering and bulk-value jobs in threads, not a new interpreter each.
-        "--force-use-threads",
-        # A study stopped part-way is resumed.
-        "--rerun-incomplete",
-    ]
-    with log.open("w") as handle:
-        res = subprocess.run(cmd, cwd=work, stdout=handle, stderr=subprocess.STDOUT, check=False)
-    if res.returncode != 0:
-        tail = "\n".join(log.read_text().splitlines()[-40:])
-        raise RuntimeError(f"snakemake {' '.join(targets)} in {work} failed ({log}):\n{tail}")
-
-
 def placeholder_experiment(config: Mapping[str, Any]) -> dict[str, Any]:
     """An experiment-file mapping with every load of the study and round values.
 
@@ -228,7 +200,7 @@ def prepare_base(profile_config: str | Path, base_dir: str | Path, cores: int = 
         (base / EXPERIMENT).write_text(yaml.safe_dump(placeholder, sort_keys=False))
     outputs = ("mu_psh", "mu_sh", "rho_b")
     targets = [f"results/surrogates/{o}/model.pt" for o in outputs]
-    _snakemake(base, cores, base / "base.log", *targets)
+    run_snakemake(base, cores, base / "base.log", *targets)
     return base
 
 
@@ -267,7 +239,7 @@ def run_case(
         )
         shutil.rmtree(work / "truth_runs")
         write_truth(work, truth)
-    _snakemake(work, cores, work / "discrepancy.log", "discrepancy")
+    run_snakemake(work, cores, work / "discrepancy.log", "discrepancy")
     return study_outcome(case, work)
 
 

@@ -23,7 +23,12 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from demcal.sequential.rounds import design_ranges, runs_per_set, verification_runs
+from demcal.sequential.rounds import (
+    design_ranges,
+    runs_per_set,
+    verification_label,
+    verification_runs,
+)
 
 
 def oneshot_sets(config: Mapping[str, Any], budget: int) -> int:
@@ -98,15 +103,12 @@ def verification_deviations(table: pd.DataFrame, engine: str = "configured") -> 
     Returns
     -------
     dict
-        ``observable@<stress>Pa,P=<P>`` (or the observable alone for the angle of repose) ->
-        ``|1 - dem / measured|``.
+        :func:`~demcal.sequential.rounds.verification_label` -> ``|1 - dem / measured|``, the
+        labels of the round records.
     """
     out = {}
     for _, row in table.iterrows():
-        label = str(row["observable"])
-        if not pd.isna(row["normal_stress"]):
-            label += f"@{row['normal_stress']:g}Pa,P={row['P']:g}"
-        out[label] = float(row[f"deviation_{engine}"])
+        out[verification_label(row)] = float(row[f"deviation_{engine}"])
     return out
 
 

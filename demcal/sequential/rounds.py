@@ -161,6 +161,14 @@ def box_volume(box: Mapping[str, Sequence[float]]) -> float:
     return float(np.prod([max(hi - lo, 0.0) for lo, hi in box.values()]))
 
 
+def verification_label(row: Mapping[str, Any]) -> str:
+    """Name of one measured value in the round records: ``mu_psh@2029Pa,P=1`` or ``aor``."""
+    label = str(row["observable"])
+    if not pd.isna(row["normal_stress"]):
+        label += f"@{row['normal_stress']:g}Pa,P={row['P']:g}"
+    return label
+
+
 def round_record(
     round_no: int,
     config: Mapping[str, Any],
@@ -206,10 +214,7 @@ def round_record(
     if verification is not None and len(verification):
         runs += verification_runs(config)
         for _, row in verification.iterrows():
-            label = row["observable"]
-            if not math.isnan(row["normal_stress"]):
-                label += f"@{row['normal_stress']:g}Pa,P={row['P']:g}"
-            checked[label] = {
+            checked[verification_label(row)] = {
                 "dem": float(row["dem_configured"]),
                 "measured": float(row["measured"]),
                 "deviation": float(row["deviation_configured"]),

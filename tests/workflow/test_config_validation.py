@@ -5,7 +5,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 import yaml
+
+from demcal.core.snakemake_run import run_snakemake
 
 ROOT = Path(__file__).resolve().parents[2]
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
@@ -100,3 +103,22 @@ def test_sequential_study_without_a_box_stops_workflow(tmp_path):
     assert res.returncode != 0
     assert "sequential.enabled" in res.stderr + res.stdout
     assert "design.kind" in res.stderr + res.stdout
+
+
+def test_study_runner_stops_naming_the_study_and_the_key(tmp_path):
+    work = tmp_path / "study"
+    (work / "config").mkdir(parents=True)
+    (work / "config" / "config.yaml").write_text(
+        yaml.safe_dump({"design": {"kind": "lhs", "samples": 3}})
+    )
+    log = tmp_path / "study.log"
+    with pytest.raises(RuntimeError) as err:
+        run_snakemake(work, 1, log, "--dry-run")
+    message = str(err.value)
+    assert str(work) in message and str(log) in message
+    assert "'samples'" in message
+    # a second call appends to the same log
+    size = log.stat().st_size
+    with pytest.raises(RuntimeError):
+        run_snakemake(work, 1, log, "--dry-run")
+    assert log.stat().st_size > size

@@ -9,25 +9,23 @@ ROOT = Path(__file__).resolve().parents[2]
 BIN = Path(sys.executable).parent
 
 
-def test_ruff_clean():
-    res = subprocess.run(
-        [str(BIN / "ruff"), "check", "demcal", "scripts", "tests"],
+def _ruff(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [str(BIN / "ruff"), *args, "demcal", "scripts", "tests"],
         cwd=ROOT,
         capture_output=True,
         text=True,
         timeout=120,
     )
+
+
+def test_ruff_clean():
+    res = _ruff("check")
     assert res.returncode == 0, res.stdout + res.stderr
 
 
 def test_ruff_format_clean():
-    res = subprocess.run(
-        [str(BIN / "ruff"), "format", "--check", "demcal", "scripts", "tests"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    res = _ruff("format", "--check")
     assert res.returncode == 0, res.stdout + res.stderr
 
 
