@@ -263,6 +263,8 @@ def replicate_record(
     noise: Mapping[str, float],
     seed: int,
     source: str,
+    observables: Sequence[str] = ("mu_psh", "mu_sh", "rho_b"),
+    p_values: Sequence[float] | None = None,
 ) -> dict[str, Any]:
     """An experiment-file mapping: the mean of the replicates with its standard deviation.
 
@@ -278,6 +280,10 @@ def replicate_record(
     noise : mapping
         Relative standard deviation of the added noise per observable (``mu_psh``, ``mu_sh``,
         ``rho_b``, ``aor``; a missing one gets none).
+    observables : sequence of str
+        Shear-cell readings to keep (partial data, as a real test may give).
+    p_values : sequence of float, optional
+        Shear load fractions to keep; all when None.
     """
     rng = np.random.default_rng(seed)
 
@@ -295,10 +301,12 @@ def replicate_record(
         value, sd = measured(aor["aor"], "aor")
         record["angle_of_repose"] = {"value": round(value, 4), "sd": round(sd, 4)}
     shear = bulk[bulk["test"] == "shear_cell"]
+    if p_values is not None:
+        shear = shear[shear["P"].round(6).isin([round(float(p), 6) for p in p_values])]
     conditions = []
     for (stress, p), rows in shear.groupby(["normal_stress", "P"], sort=True):
         entry: dict[str, float] = {"normal_stress": float(stress), "P": float(p)}
-        for name in ("mu_psh", "mu_sh", "rho_b"):
+        for name in observables:
             if rows[name].notna().any():
                 value, sd = measured(rows[name], name)
                 entry[name] = round(value, 6)

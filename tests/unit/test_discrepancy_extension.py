@@ -253,3 +253,26 @@ def test_replicate_record_states_mean_and_scatter():
     assert noisy["rho_b_sd"] == pytest.approx(math.hypot(5.0, 0.02 * 1705.0), rel=1e-5)
     assert noisy["mu_sh"] == pytest.approx(0.4) and noisy["mu_sh_sd"] == 0.0
     assert "angle_of_repose" not in record
+
+
+def test_replicate_record_keeps_the_readings_and_loads_asked_for():
+    bulk = pd.DataFrame(
+        {
+            "test": ["shear_cell"] * 4 + ["angle_of_repose"],
+            "normal_stress": [1068.0, 1068.0, 2029.0, 2029.0, np.nan],
+            "P": [0.6, 1.0, 0.6, 1.0, np.nan],
+            "replicate": 0,
+            "mu_psh": [0.7, 0.6, 0.68, 0.58, np.nan],
+            "mu_sh": [0.5, 0.55, 0.48, 0.52, np.nan],
+            "rho_b": [1500.0, 1510.0, 1520.0, 1530.0, np.nan],
+            "aor": [np.nan] * 4 + [31.0],
+        }
+    )
+    record = replicate_record(bulk, "m", {}, 1, "t", observables=["mu_psh", "rho_b"], p_values=[1])
+    assert [(c["normal_stress"], c["P"]) for c in record["shear_cell"]] == [
+        (1068.0, 1.0),
+        (2029.0, 1.0),
+    ]
+    assert [c["mu_psh"] for c in record["shear_cell"]] == [0.6, 0.58]
+    assert all("mu_sh" not in c for c in record["shear_cell"])
+    assert record["angle_of_repose"]["value"] == 31.0
