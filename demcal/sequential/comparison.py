@@ -160,8 +160,8 @@ def comparison_row(
     row["worst_bulk_value"] = worst
     values = sorted(deviations.values())
     row["median_bulk_deviation"] = float(np.median(values)) if values else math.nan
-    row["share_within"] = sum(v <= tolerance for v in values) / len(values) if values else math.nan
-    row["within"] = bool(deviations) and all(v <= tolerance for v in deviations.values())
+    row["share_within"] = sum(v < tolerance for v in values) / len(values) if values else math.nan
+    row["within"] = bool(deviations) and all(v < tolerance for v in deviations.values())
     return row
 
 
