@@ -65,13 +65,20 @@ DEFAULT_SPECS = [TRUTHS / "synthetic_reference.yaml", TRUTHS / "synthetic_drawn.
 EXPERIMENT = "config/experiments/measured.yaml"
 
 
+def write_if_changed(path: Path, text: str) -> None:
+    """Write ``text`` unless the file already holds it: an unchanged file keeps its time stamp,
+    so that a resumed study does not redo the steps that read it."""
+    if not (path.is_file() and path.read_text() == text):
+        path.write_text(text)
+
+
 def write_study_config(work: Path, config: dict[str, Any], experiment: Path) -> dict[str, Any]:
     """Write a study directory's configuration and measurements; return it validated."""
     (work / "config" / "experiments").mkdir(parents=True, exist_ok=True)
-    shutil.copyfile(experiment, work / EXPERIMENT)
+    write_if_changed(work / EXPERIMENT, experiment.read_text())
     config = {**config, "experiment": EXPERIMENT}
     path = work / "config" / "config.yaml"
-    path.write_text(yaml.safe_dump(config, sort_keys=False))
+    write_if_changed(path, yaml.safe_dump(config, sort_keys=False))
     return validate_config(copy.deepcopy(config), str(path))
 
 
