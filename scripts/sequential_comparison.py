@@ -17,7 +17,8 @@ directories of their own under OUT/<material>/:
 
 Writes OUT/comparison.csv, OUT/comparison.md (the table, with the command) and
 OUT/comparison.png (error against DEM runs for both designs). Resumable: finished studies are
-read back, not run again.
+read back, not run again, and an interrupted one continues (the driver unlocks its own study
+directories, so do not run two drivers on the same OUT).
 
 Usage: python scripts/sequential_comparison.py --out results/sequential_comparison \\
     [--profile config/config.yaml] [--sequential config/sequential.yaml] \\
@@ -181,6 +182,8 @@ def main() -> None:
         config = write_study_config(work, seq_config, experiment)
         ranges = design_ranges(config)
         tol = float(config["screening"]["tolerance"])
+        # The driver owns its study directories: a lock left by an interrupted call goes.
+        run_snakemake(work, args.cores, mdir / "sequential.log", "--unlock")
         run_snakemake(work, args.cores, mdir / "sequential.log", "sequential")
         rows += sequential_rows(work, material, truth, ranges, tol)
         previous = None
@@ -192,6 +195,7 @@ def main() -> None:
             one_config = write_study_config(work, one, experiment)
             if not (work / "results" / "verification" / "verification.csv").is_file():
                 log = mdir / f"oneshot_{budget}.log"
+                run_snakemake(work, args.cores, log, "--unlock")
                 run_snakemake(work, args.cores, log, "results/design/cases.csv")
                 if previous is not None:
                     reuse_cases(previous, work)
