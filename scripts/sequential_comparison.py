@@ -184,7 +184,10 @@ def main() -> None:
         tol = float(config["screening"]["tolerance"])
         # The driver owns its study directories: a lock left by an interrupted call goes.
         run_snakemake(work, args.cores, mdir / "sequential.log", "--unlock")
-        run_snakemake(work, args.cores, mdir / "sequential.log", "sequential")
+        # Finished DEM runs are kept when the code changed since (a resumed comparison).
+        run_snakemake(
+            work, args.cores, mdir / "sequential.log", "sequential", "--rerun-triggers", "mtime"
+        )
         rows += sequential_rows(work, material, truth, ranges, tol)
         previous = None
         for budget in budgets:
