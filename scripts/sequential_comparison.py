@@ -49,14 +49,16 @@ from demcal.discrepancy.synthetic import (
     replicate_record,
     write_truth,
 )
-from demcal.discrepancy.truths import draw_truth, load_truth_spec
+from demcal.discrepancy.truths import DrawnTruth, draw_truth, load_truth_spec
 from demcal.engine_io.run import installed_liggghts
 from demcal.sequential.comparison import (
     comparison_figure,
     comparison_markdown,
     oneshot_row,
     oneshot_sets,
+    record_deviations,
     sequential_rows,
+    truth_row,
 )
 from demcal.sequential.rounds import design_ranges
 
@@ -83,6 +85,52 @@ def write_study_config(work: Path, config: dict[str, Any], experiment: Path) -> 
     return validate_config(copy.deepcopy(config), str(path))
 
 
+def run_truth(
+    truth: DrawnTruth,
+    config: dict[str, Any],
+    bulk_file: Path,
+    replicates: int,
+    engine: str | None,
+    cores: int,
+) -> pd.DataFrame:
+    """Bulk values of both tests at the truth, kept in ``bulk_file`` (read back when there)."""
+    if not bulk_file.is_file():
+        runs = bulk_file.with_suffix("")
+        bulk = hidden_effect_bulk(
+            truth,
+            config,
+            runs,
+            tests=("shear_cell", "angle_of_repose"),
+            workers=cores,
+            replicates=replicates,
+            engine_command=engine,
+        )
+        bulk.to_csv(bulk_file, index=False)
+        shutil.rmtree(runs)
+    return pd.read_csv(bulk_file)
+
+
+def engine_truth_row(
+    spec: Path, config: dict[str, Any], mdir: Path, experiment: Path, args: argparse.Namespace
+) -> dict[str, Any]:
+    """The truth run like a verification on the engine under calibration (the error floor)."""
+    validated = validate_config(copy.deepcopy(config), str(spec))
+    seeds = int(validated["verification"]["seeds"])
+    truth = draw_truth(load_truth_spec(spec), validated, args.truth_seed, str(spec))
+    bulk = run_truth(truth, validated, mdir / "engine_truth_bulk.csv", seeds, None, args.cores)
+    measured = yaml.safe_load(experiment.read_text())
+    dem = replicate_record(bulk, measured["material"], {}, 0, "", ("mu_psh", "mu_sh", "rho_b"))
+    return truth_row(
+        measured["material"],
+        len(bulk),
+        record_deviations(measured, dem),
+        {k: float(v) for k, v in truth.parameters.items()},
+        design_ranges(validated),
+        float(validated["screening"]["tolerance"]),
+        f"{seeds} seeds, `{validated['engine']['command']}`",
+    )
+
+
 def make_measurements(
     spec: Path, config: dict[str, Any], mdir: Path, args: argparse.Namespace
 ) -> tuple[Path, dict[str, float]]:
@@ -96,18 +144,8 @@ def make_measurements(
     validated = validate_config(copy.deepcopy(config), str(spec))
     if not (bulk_file.is_file() and truth_file.is_file()):
         truth = draw_truth(load_truth_spec(spec), validated, args.truth_seed, str(spec))
-        bulk = hidden_effect_bulk(
-            truth,
-            validated,
-            mdir / "truth_runs",
-            tests=("shear_cell", "angle_of_repose"),
-            workers=args.cores,
-            replicates=args.replicates,
-            engine_command=args.truth_engine,
-        )
-        bulk.to_csv(bulk_file, index=False)
+        run_truth(truth, validated, bulk_file, args.replicates, args.truth_engine, args.cores)
         write_truth(mdir, truth)
-        shutil.rmtree(mdir / "truth_runs")
     truth = yaml.safe_load(truth_file.read_text())
     if not experiment.is_file():
         observables = args.observables.split(",")
@@ -189,6 +227,7 @@ def main() -> None:
             work, args.cores, mdir / "sequential.log", "sequential", "--rerun-triggers", "mtime"
         )
         rows += sequential_rows(work, material, truth, ranges, tol)
+        rows.append(engine_truth_row(spec, base, mdir, experiment, args))
         previous = None
         for budget in budgets:
             sets = oneshot_sets(config, budget)

@@ -5,7 +5,8 @@ its rounds, or ``one-shot`` with a budget), the DEM runs spent on it (every engi
 its verification included), the error of its mean set against the truth per parameter (as a
 fraction of the design range, since the parameters have different units) and its error against
 the measurements per bulk value by DEM verification (``|1 - dem / measured|``, the deviation
-the verification table reports).
+the verification table reports). A ``truth`` row runs the true parameters like a verification
+on the engine under calibration: the error no calibration can go below.
 """
 
 from __future__ import annotations
@@ -112,6 +113,61 @@ def verification_deviations(table: pd.DataFrame, engine: str = "configured") -> 
     return out
 
 
+def record_deviations(measured: Mapping[str, Any], dem: Mapping[str, Any]) -> dict[str, float]:
+    """Deviation of DEM means from each measured value, both as experiment-file mappings.
+
+    Parameters
+    ----------
+    measured : mapping
+        The measurements (``angle_of_repose: {value}``, ``shear_cell: [{normal_stress, P,
+        mu_psh, ...}]``).
+    dem : mapping
+        The DEM means in the same form
+        (:func:`~demcal.discrepancy.synthetic.replicate_record` without noise).
+
+    Returns
+    -------
+    dict
+        :func:`~demcal.sequential.rounds.verification_label` -> ``|1 - dem / measured|`` for
+        every measured value the DEM runs also gave.
+    """
+    out = {}
+    if "angle_of_repose" in measured and "angle_of_repose" in dem:
+        ratio = dem["angle_of_repose"]["value"] / measured["angle_of_repose"]["value"]
+        out["aor"] = abs(1.0 - float(ratio))
+    conditions = {(float(c["normal_stress"]), float(c["P"])): c for c in dem.get("shear_cell", [])}
+    for condition in measured.get("shear_cell", []):
+        key = (float(condition["normal_stress"]), float(condition["P"]))
+        for name, value in condition.items():
+            other = conditions.get(key, {})
+            if name in ("normal_stress", "P") or name.endswith("_sd") or name not in other:
+                continue
+            label = verification_label({"observable": name, "normal_stress": key[0], "P": key[1]})
+            out[label] = abs(1.0 - float(other[name]) / float(value))
+    return out
+
+
+def truth_row(
+    material: str,
+    runs: int,
+    deviations: Mapping[str, float],
+    truth: Mapping[str, float],
+    ranges: Mapping[str, Sequence[float]],
+    tolerance: float,
+    label: str,
+) -> dict[str, Any]:
+    """The row of the truth itself run on the engine under calibration: the floor of the error.
+
+    A calibration cannot beat the deviation the true parameters show when they are run like a
+    verification (same engine, same number of seeds) against measurements made on the reference
+    code: seed scatter on both sides and any difference between the codes.
+    """
+    identified = {"parameters": {k: {"mean": float(v)} for k, v in truth.items()}}
+    return comparison_row(
+        material, "truth", runs, identified, deviations, truth, ranges, tolerance, label
+    )
+
+
 def comparison_row(
     material: str,
     design: str,
@@ -130,7 +186,7 @@ def comparison_row(
     material : str
         Name of the synthetic material.
     design : str
-        ``sequential`` or ``one-shot``.
+        ``sequential``, ``one-shot`` or ``truth``.
     runs : int
         DEM runs spent, the verification included.
     identified, truth, ranges
@@ -263,7 +319,7 @@ def comparison_markdown(table: pd.DataFrame, tolerance: float, command: str) -> 
     lines.append("")
     for material, rows in table.groupby("material", sort=False):
         parts = []
-        for design, drows in rows.groupby("design", sort=False):
+        for design, drows in rows[rows["design"] != "truth"].groupby("design", sort=False):
             ok = drows[drows["within"]]
             parts.append(
                 f"{design}: "
@@ -275,6 +331,12 @@ def comparison_markdown(table: pd.DataFrame, tolerance: float, command: str) -> 
             + "; ".join(parts)
             + "."
         )
+        for _, floor in rows[rows["design"] == "truth"].iterrows():
+            lines.append(
+                f"- {material}, the truth itself ({floor['label']}): worst deviation "
+                f"{floor['worst_bulk_deviation']:.3f} ({floor['worst_bulk_value']}), "
+                f"{floor['share_within']:.0%} of the values within tolerance."
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -298,6 +360,10 @@ def comparison_figure(table: pd.DataFrame, tolerance: float, path: str | Path) -
             )
             axes[1][col].plot(d["runs"], d["max_parameter_error"], style, color=color, label=design)
         axes[0][col].axhline(tolerance, color="0.5", lw=0.8, ls=":", label="tolerance")
+        for _, floor in rows[rows["design"] == "truth"].iterrows():
+            axes[0][col].axhline(
+                floor["worst_bulk_deviation"], color="C2", lw=1.5, ls="-.", label="truth itself"
+            )
         axes[0][col].set_title(material, fontsize=9)
         axes[0][col].set_ylabel("worst |1 - DEM / measured|")
         axes[1][col].set_ylabel("largest |mean - truth| / range")

@@ -15,7 +15,9 @@ from demcal.sequential.comparison import (
     oneshot_row,
     oneshot_sets,
     parameter_errors,
+    record_deviations,
     sequential_rows,
+    truth_row,
     verification_deviations,
 )
 from tests.figures import colour_mask, read_png
@@ -166,10 +168,28 @@ def test_table_and_figure_report_the_fewest_runs_within_tolerance(tmp_path):
             "within": False,
         },
     ]
+    rows.append(
+        {
+            "material": "a",
+            "design": "truth",
+            "label": "3 seeds, `dem_engine -in {deck}`",
+            "runs": 15,
+            "max_parameter_error": 0.0,
+            "worst_bulk_deviation": 0.045,
+            "worst_bulk_value": "aor",
+            "share_within": 1.0,
+            "within": True,
+        }
+    )
     table = pd.DataFrame(rows)
     text = comparison_markdown(table, 0.05, "python scripts/sequential_comparison.py")
     assert "sequential: 72 DEM runs (of 72 spent)" in text
     assert "one-shot: not within tolerance (of 100 spent)" in text
+    # the truth is the floor, not a design that spent runs
+    assert "truth: " not in text
+    assert (
+        "the truth itself (3 seeds, `dem_engine -in {deck}`): worst deviation 0.045 (aor)" in text
+    )
     (line,) = [x for x in text.splitlines() if "round 0" in x]
     assert "0.090" in line and "0.200" in line
     comparison_figure(table, 0.05, tmp_path / "c.png")
@@ -178,3 +198,36 @@ def test_table_and_figure_report_the_fewest_runs_within_tolerance(tmp_path):
     # both designs drawn: the sequential line in C0, the one-shot line in C3
     assert colour_mask(image, "#1f77b4").sum() > 100
     assert colour_mask(image, "#d62728").sum() > 100
+    # the truth's floor as a line of its own (C2)
+    assert colour_mask(image, "#2ca02c").sum() > 50
+
+
+def test_measured_and_dem_records_compare_value_by_value():
+    measured = {
+        "angle_of_repose": {"value": 32.0, "sd": 0.6},
+        "shear_cell": [
+            {"normal_stress": 1068.0, "P": 1.0, "mu_psh": 0.99, "mu_psh_sd": 0.05, "rho_b": 1577.0},
+            {"normal_stress": 2029.0, "P": 1.0, "mu_psh": 0.93},
+        ],
+    }
+    dem = {
+        "angle_of_repose": {"value": 30.4},
+        "shear_cell": [
+            {"normal_stress": 1068.0, "P": 1.0, "mu_psh": 1.0395, "rho_b": 1577.0, "mu_sh": 0.8},
+            {"normal_stress": 10070.0, "P": 1.0, "mu_psh": 0.5},
+        ],
+    }
+    out = record_deviations(measured, dem)
+    # what is measured and run is compared; not what only one of them has, never the sd
+    assert set(out) == {"aor", "mu_psh@1068Pa,P=1", "rho_b@1068Pa,P=1"}
+    assert out["aor"] == pytest.approx(0.05)
+    assert out["mu_psh@1068Pa,P=1"] == pytest.approx(0.05)
+    assert out["rho_b@1068Pa,P=1"] == pytest.approx(0.0)
+
+
+def test_truth_row_has_no_parameter_error_and_judges_the_bulk_values():
+    row = truth_row("a", 15, {"aor": 0.02, "mu_psh@2029Pa,P=1": 0.08}, TRUTH, RANGES, 0.05, "x")
+    assert row["design"] == "truth" and row["runs"] == 15
+    assert row["max_parameter_error"] == 0.0
+    assert row["worst_bulk_value"] == "mu_psh@2029Pa,P=1" and row["share_within"] == 0.5
+    assert not row["within"]
