@@ -14,6 +14,8 @@ directories of their own under OUT/<material>/:
 * ``oneshot_<B>/``: for each budget B of --budgets, a one-shot Sobol' design of as many sets
   as B allows after one verification, screened and verified like the default study. The Sobol'
   designs of the budgets are nested, so the DEM runs of a smaller budget are reused by the next.
+  The designs do not depend on the material, so a later material copies its one-shot cases
+  from the earlier one's (counted as spent all the same: the copy only saves the driver time).
 
 Writes OUT/comparison.csv, OUT/comparison.md (the table, with the command) and
 OUT/comparison.png (error against DEM runs for both designs). Resumable: finished studies are
@@ -30,11 +32,9 @@ from __future__ import annotations
 
 import argparse
 import copy
-import os
 import shlex
 import shutil
 import sys
-import time
 from pathlib import Path
 from typing import Any
 
@@ -57,6 +57,7 @@ from demcal.sequential.comparison import (
     oneshot_row,
     oneshot_sets,
     record_deviations,
+    reuse_cases,
     sequential_rows,
     truth_row,
 )
@@ -167,23 +168,6 @@ def make_measurements(
     return experiment, {k: float(v) for k, v in truth["parameters"].items()}
 
 
-def reuse_cases(source: Path, target: Path) -> None:
-    """Copy the finished DEM cases of a smaller nested design, newer than the target's design.
-
-    The copies are stamped in the order of the rules (deck, then run status, then bulk values)
-    so that Snakemake sees them as made from the target's design table, not as outdated.
-    """
-    cases = source / "results" / "cases"
-    if not cases.is_dir():
-        return
-    shutil.copytree(cases, target / "results" / "cases", dirs_exist_ok=True)
-    now = time.time()
-    for path in (target / "results" / "cases").rglob("*"):
-        if path.is_file():
-            later = {"status.json": 1.0, "bulk.csv": 2.0}.get(path.name, 0.0)
-            os.utime(path, (now + later, now + later))
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", required=True, type=Path, help="directory of the comparison")
@@ -211,6 +195,9 @@ def main() -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     command = "python " + " ".join(shlex.quote(a) for a in sys.argv)
     rows = []
+    # The designs do not depend on the measurements: every material's one-shot studies run the
+    # same cases, so a later material reuses the largest one-shot study of an earlier one.
+    donor: Path | None = None
     for spec in args.spec or DEFAULT_SPECS:
         mdir = args.out / spec.stem
         mdir.mkdir(parents=True, exist_ok=True)
@@ -239,8 +226,9 @@ def main() -> None:
                 log = mdir / f"oneshot_{budget}.log"
                 run_snakemake(work, args.cores, log, "--unlock")
                 run_snakemake(work, args.cores, log, "results/design/cases.csv")
-                if previous is not None:
-                    reuse_cases(previous, work)
+                source = donor or previous
+                if source is not None:
+                    reuse_cases(source, work)
                 run_snakemake(
                     work,
                     args.cores,
@@ -251,6 +239,7 @@ def main() -> None:
                 )
             rows.append(oneshot_row(work, material, one_config, truth))
             previous = work
+        donor = previous
         table = pd.DataFrame(rows)
         table.to_csv(args.out / "comparison.csv", index=False, float_format="%.6g")
         (args.out / "comparison.md").write_text(comparison_markdown(table, tol, command))

@@ -13,6 +13,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import shutil
+import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -54,6 +57,36 @@ def oneshot_sets(config: Mapping[str, Any], budget: int) -> int:
             f"({verification_runs(config)} runs); at least 3 are needed"
         )
     return n
+
+
+def reuse_cases(source: str | Path, target: str | Path) -> None:
+    """Copy the finished DEM cases of the same nested design that the target's design holds.
+
+    Only cases of the target's design table are copied (a case directory is named after its
+    ``case_id``, with a ``_s<n>`` suffix per shear-cell deck). The copies are stamped in the
+    order of the rules (deck, then run status, then bulk values) so that Snakemake sees them as
+    made from the target's design table, not as outdated.
+
+    Parameters
+    ----------
+    source, target : path
+        Study directories of the same configuration; the target's design table exists.
+    """
+    source, target = Path(source), Path(target)
+    cases = source / "results" / "cases"
+    if not cases.is_dir():
+        return
+    wanted = set(pd.read_csv(target / "results" / "design" / "cases.csv")["case_id"])
+    now = time.time()
+    for case in cases.glob("*/*"):
+        if case.name.split("_s")[0] not in wanted:
+            continue
+        dest = target / "results" / "cases" / case.parent.name / case.name
+        shutil.copytree(case, dest, dirs_exist_ok=True)
+        for path in dest.rglob("*"):
+            if path.is_file():
+                later = {"status.json": 1.0, "bulk.csv": 2.0}.get(path.name, 0.0)
+                os.utime(path, (now + later, now + later))
 
 
 def parameter_errors(

@@ -3,6 +3,7 @@ measurements, the rows read from study directories, the table and the figure."""
 
 import json
 import math
+import os
 
 import pandas as pd
 import pytest
@@ -16,6 +17,7 @@ from demcal.sequential.comparison import (
     oneshot_sets,
     parameter_errors,
     record_deviations,
+    reuse_cases,
     sequential_rows,
     truth_row,
     verification_deviations,
@@ -231,3 +233,28 @@ def test_truth_row_has_no_parameter_error_and_judges_the_bulk_values():
     assert row["max_parameter_error"] == 0.0
     assert row["worst_bulk_value"] == "mu_psh@2029Pa,P=1" and row["share_within"] == 0.5
     assert not row["within"]
+
+
+def test_reused_cases_are_those_of_the_target_design_and_newer_than_it(tmp_path):
+    source, target = tmp_path / "a", tmp_path / "b"
+    for case in ("shear_cell/c0001_s1", "shear_cell/c0012_s1", "angle_of_repose/c0001"):
+        d = source / "results" / "cases" / case
+        d.mkdir(parents=True)
+        for name in ("in.deck", "status.json", "bulk.csv"):
+            (d / name).write_text(case)
+    design = target / "results" / "design" / "cases.csv"
+    design.parent.mkdir(parents=True)
+    design.write_text("case_id,density\nc0001,3000\nc0002,3100\n")
+    os.utime(design, (1.0e9, 1.0e9))
+    reuse_cases(source, target)
+    cases = target / "results" / "cases"
+    # c0012 is not in the target's design; c0002 was never run
+    assert sorted(p.relative_to(cases).as_posix() for p in cases.glob("*/*")) == [
+        "angle_of_repose/c0001",
+        "shear_cell/c0001_s1",
+    ]
+    case = cases / "shear_cell" / "c0001_s1"
+    assert (case / "bulk.csv").read_text() == "shear_cell/c0001_s1"
+    # stamped in the order of the rules, all after the design table
+    times = [(case / n).stat().st_mtime for n in ("in.deck", "status.json", "bulk.csv")]
+    assert design.stat().st_mtime < times[0] < times[1] < times[2]
