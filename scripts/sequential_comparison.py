@@ -123,7 +123,7 @@ def engine_truth_row(
     dem = replicate_record(bulk, measured["material"], {}, 0, "", ("mu_psh", "mu_sh", "rho_b"))
     return truth_row(
         measured["material"],
-        len(bulk),
+        int(bulk["case_id"].nunique()),  # engine executions: one per deck
         record_deviations(measured, dem),
         {k: float(v) for k, v in truth.parameters.items()},
         design_ranges(validated),
