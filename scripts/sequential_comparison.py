@@ -42,6 +42,7 @@ import pandas as pd
 import yaml
 
 from demcal.core.config import validate_config
+from demcal.core.experiments import load_experiment
 from demcal.core.snakemake_run import run_snakemake
 from demcal.discrepancy.candidates import deep_merge
 from demcal.discrepancy.synthetic import (
@@ -56,7 +57,6 @@ from demcal.sequential.comparison import (
     comparison_markdown,
     oneshot_row,
     oneshot_sets,
-    record_deviations,
     reuse_cases,
     sequential_rows,
     truth_row,
@@ -119,12 +119,11 @@ def engine_truth_row(
     seeds = int(validated["verification"]["seeds"])
     truth = draw_truth(load_truth_spec(spec), validated, args.truth_seed, str(spec))
     bulk = run_truth(truth, validated, mdir / "engine_truth_bulk.csv", seeds, None, args.cores)
-    measured = yaml.safe_load(experiment.read_text())
-    dem = replicate_record(bulk, measured["material"], {}, 0, "", ("mu_psh", "mu_sh", "rho_b"))
+    measured = load_experiment(experiment)
     return truth_row(
-        measured["material"],
-        int(bulk["case_id"].nunique()),  # engine executions: one per deck
-        record_deviations(measured, dem),
+        measured.material,
+        bulk,
+        measured,
         {k: float(v) for k, v in truth.parameters.items()},
         design_ranges(validated),
         float(validated["screening"]["tolerance"]),

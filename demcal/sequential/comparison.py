@@ -27,6 +27,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from demcal.core.experiments import Experiment
+from demcal.identification.verification import verification_table
 from demcal.sequential.rounds import (
     design_ranges,
     runs_per_set,
@@ -146,44 +148,10 @@ def verification_deviations(table: pd.DataFrame, engine: str = "configured") -> 
     return out
 
 
-def record_deviations(measured: Mapping[str, Any], dem: Mapping[str, Any]) -> dict[str, float]:
-    """Deviation of DEM means from each measured value, both as experiment-file mappings.
-
-    Parameters
-    ----------
-    measured : mapping
-        The measurements (``angle_of_repose: {value}``, ``shear_cell: [{normal_stress, P,
-        mu_psh, ...}]``).
-    dem : mapping
-        The DEM means in the same form
-        (:func:`~demcal.discrepancy.synthetic.replicate_record` without noise).
-
-    Returns
-    -------
-    dict
-        :func:`~demcal.sequential.rounds.verification_label` -> ``|1 - dem / measured|`` for
-        every measured value the DEM runs also gave.
-    """
-    out = {}
-    if "angle_of_repose" in measured and "angle_of_repose" in dem:
-        ratio = dem["angle_of_repose"]["value"] / measured["angle_of_repose"]["value"]
-        out["aor"] = abs(1.0 - float(ratio))
-    conditions = {(float(c["normal_stress"]), float(c["P"])): c for c in dem.get("shear_cell", [])}
-    for condition in measured.get("shear_cell", []):
-        key = (float(condition["normal_stress"]), float(condition["P"]))
-        for name, value in condition.items():
-            other = conditions.get(key, {})
-            if name in ("normal_stress", "P") or name.endswith("_sd") or name not in other:
-                continue
-            label = verification_label({"observable": name, "normal_stress": key[0], "P": key[1]})
-            out[label] = abs(1.0 - float(other[name]) / float(value))
-    return out
-
-
 def truth_row(
     material: str,
-    runs: int,
-    deviations: Mapping[str, float],
+    bulk: pd.DataFrame,
+    experiment: Experiment,
     truth: Mapping[str, float],
     ranges: Mapping[str, Sequence[float]],
     tolerance: float,
@@ -193,11 +161,33 @@ def truth_row(
 
     A calibration cannot beat the deviation the true parameters show when they are run like a
     verification (same engine, same number of seeds) against measurements made on the reference
-    code: seed scatter on both sides and any difference between the codes.
+    code: seed scatter on both sides and any difference between the codes. The runs are judged
+    by the verification table of an identified set.
+
+    Parameters
+    ----------
+    material : str
+        Name of the synthetic material.
+    bulk : DataFrame
+        Bulk rows of the runs at the truth (tidy layout of ``demcal.bulk.dataset``, column
+        ``case_id``: one engine execution per case).
+    experiment : Experiment
+        The measurements.
+    truth, ranges, tolerance, label
+        As in :func:`comparison_row`.
     """
+    table = verification_table({"configured": bulk}, experiment, tolerance)
     identified = {"parameters": {k: {"mean": float(v)} for k, v in truth.items()}}
     return comparison_row(
-        material, "truth", runs, identified, deviations, truth, ranges, tolerance, label
+        material,
+        "truth",
+        int(bulk["case_id"].nunique()),
+        identified,
+        verification_deviations(table),
+        truth,
+        ranges,
+        tolerance,
+        label,
     )
 
 

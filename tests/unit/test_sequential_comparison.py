@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from demcal.core.config import load_config
+from demcal.core.experiments import load_experiment
 from demcal.sequential.comparison import (
     comparison_figure,
     comparison_markdown,
@@ -16,7 +17,6 @@ from demcal.sequential.comparison import (
     oneshot_row,
     oneshot_sets,
     parameter_errors,
-    record_deviations,
     reuse_cases,
     sequential_rows,
     truth_row,
@@ -204,34 +204,64 @@ def test_table_and_figure_report_the_fewest_runs_within_tolerance(tmp_path):
     assert colour_mask(image, "#2ca02c").sum() > 50
 
 
-def test_measured_and_dem_records_compare_value_by_value():
-    measured = {
+def _truth_bulk():
+    """Two replicates of the truth: a heap and one shear-cell deck at 1068 Pa each."""
+    return pd.DataFrame(
+        {
+            "case_id": ["truth0", "truth0_s1", "truth1", "truth1_s1"],
+            "test": ["angle_of_repose", "shear_cell"] * 2,
+            "normal_stress": [math.nan, 1068.0] * 2,
+            "P": [math.nan, 1.0] * 2,
+            "aor": [29.6, math.nan, 30.4, math.nan],
+            "mu_psh": [math.nan, 1.0, math.nan, 1.04],
+            "mu_sh": [math.nan, 0.8, math.nan, 0.8],
+            "rho_b": [math.nan, 1570.0, math.nan, 1584.0],
+        }
+    )
+
+
+def _experiment(tmp_path, conditions):
+    path = tmp_path / "measured.yaml"
+    record = {
+        "material": "m",
+        "source": "test",
         "angle_of_repose": {"value": 32.0, "sd": 0.6},
-        "shear_cell": [
-            {"normal_stress": 1068.0, "P": 1.0, "mu_psh": 0.99, "mu_psh_sd": 0.05, "rho_b": 1577.0},
+        "shear_cell": conditions,
+    }
+    path.write_text(json.dumps(record))
+    return load_experiment(path)
+
+
+def test_truth_row_judges_the_truth_runs_like_a_verification(tmp_path):
+    experiment = _experiment(
+        tmp_path,
+        [{"normal_stress": 1068.0, "P": 1.0, "mu_psh": 0.99, "mu_psh_sd": 0.05, "rho_b": 1577.0}],
+    )
+    row = truth_row("a", _truth_bulk(), experiment, TRUTH, RANGES, 0.05, "x")
+    assert row["design"] == "truth" and row["label"] == "x"
+    # 4 engine executions (2 heaps, 2 shear decks), not bulk-value rows
+    assert row["runs"] == 4
+    assert row["max_parameter_error"] == 0.0
+    # means over the replicates: AoR 30.0 vs 32, mu_psh 1.02 vs 0.99, rho_b 1577 vs 1577;
+    # mu_sh was run but not measured, so it is not judged
+    assert row["worst_bulk_value"] == "aor"
+    assert row["worst_bulk_deviation"] == pytest.approx(0.0625)
+    assert row["median_bulk_deviation"] == pytest.approx(0.03 / 0.99)
+    assert row["share_within"] == pytest.approx(2 / 3)
+    assert not row["within"]
+
+
+def test_truth_row_counts_a_measured_value_without_runs_as_missed(tmp_path):
+    experiment = _experiment(
+        tmp_path,
+        [
+            {"normal_stress": 1068.0, "P": 1.0, "rho_b": 1577.0},
             {"normal_stress": 2029.0, "P": 1.0, "mu_psh": 0.93},
         ],
-    }
-    dem = {
-        "angle_of_repose": {"value": 30.4},
-        "shear_cell": [
-            {"normal_stress": 1068.0, "P": 1.0, "mu_psh": 1.0395, "rho_b": 1577.0, "mu_sh": 0.8},
-            {"normal_stress": 10070.0, "P": 1.0, "mu_psh": 0.5},
-        ],
-    }
-    out = record_deviations(measured, dem)
-    # what is measured and run is compared; not what only one of them has, never the sd
-    assert set(out) == {"aor", "mu_psh@1068Pa,P=1", "rho_b@1068Pa,P=1"}
-    assert out["aor"] == pytest.approx(0.05)
-    assert out["mu_psh@1068Pa,P=1"] == pytest.approx(0.05)
-    assert out["rho_b@1068Pa,P=1"] == pytest.approx(0.0)
-
-
-def test_truth_row_has_no_parameter_error_and_judges_the_bulk_values():
-    row = truth_row("a", 15, {"aor": 0.02, "mu_psh@2029Pa,P=1": 0.08}, TRUTH, RANGES, 0.05, "x")
-    assert row["design"] == "truth" and row["runs"] == 15
-    assert row["max_parameter_error"] == 0.0
-    assert row["worst_bulk_value"] == "mu_psh@2029Pa,P=1" and row["share_within"] == 0.5
+    )
+    row = truth_row("a", _truth_bulk(), experiment, TRUTH, RANGES, 0.5, "x")
+    # AoR and rho_b within 50 %, mu_psh at 2029 Pa never run: not within, as in a verification
+    assert row["share_within"] == pytest.approx(2 / 3)
     assert not row["within"]
 
 
