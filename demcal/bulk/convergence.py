@@ -132,6 +132,24 @@ FACTORS: dict[str, Factor] = {
             "particles.scale",
         ),
         Factor(
+            "ring_dCylDp",
+            "shear_cell",
+            "ring cell: outer diameter / particle diameter dCylDp (R / R_i = 2)",
+            tuple(
+                {
+                    "shear_cell.geometry": "ring",
+                    "shear_cell.dCylDp": float(d),
+                    # Bed height (6 diameters) and pre-shear travel (9 diameters) fixed in
+                    # particle sizes, so that only the width (dCylDp / 4 diameters) varies.
+                    "shear_cell.fill_height": 12.0 / d,
+                    "shear_cell.overfill": 2.0 / d,
+                    "shear_cell.preshear_travel": 18.0 / d,
+                }
+                for d in (16, 24, 32, 40)
+            ),
+            "shear_cell.dCylDp",
+        ),
+        Factor(
             "aor_dCylDp",
             "angle_of_repose",
             "cylinder diameter / largest particle diameter dCylDp",

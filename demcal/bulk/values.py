@@ -31,7 +31,7 @@ from demcal.decks.render import CASE_FILE
 from demcal.engine_io.dump_file import read_dump_last
 from demcal.engine_io.fix_output import read_print_file
 from demcal.virtual_tests.angle_of_repose.readout import angle_of_repose
-from demcal.virtual_tests.shear_cell.readout import REQUIRED_COLUMNS, shear_cell_bulk_values
+from demcal.virtual_tests.shear_cell.readout import required_columns, shear_cell_bulk_values
 
 __all__ = [
     "REPOSE_COLUMNS",
@@ -124,7 +124,9 @@ def _shear_cell(case_dir: Path, record: Mapping[str, Any]) -> pd.DataFrame:
     setup = record["setup"]
     readout = record["readout"]
     path = _output(case_dir, record, "table")
-    table = read_print_file(path, columns=[*REQUIRED_COLUMNS, "step"])
+    # Case records written before the ring cell have no inner radius.
+    inner = float(readout.get("inner_radius", 0.0))
+    table = read_print_file(path, columns=[*required_columns(inner), "step"])
     _check_complete(table, path, int(setup["total_steps"]), int(setup["print_every"]))
     values = shear_cell_bulk_values(
         table,
@@ -132,6 +134,7 @@ def _shear_cell(case_dir: Path, record: Mapping[str, Any]) -> pd.DataFrame:
         float(readout["z_floor"]),
         float(readout["z_shear"]),
         float(readout["gravity"]),
+        inner_radius=inner,
         min_fraction=float(readout["min_fraction"]),
     )
     cycles = setup["cycles"]

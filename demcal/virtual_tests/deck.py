@@ -19,7 +19,7 @@ import numpy as np
 
 from demcal.core.parameters import CONTACT_PARAMETERS, GRAVITY, TESTS
 from demcal.decks.case_validation import ValidationRules, validate_case
-from demcal.decks.mesh_primitives import annulus, cylinder_shell, disc
+from demcal.decks.mesh_primitives import annulus, cylinder_shell, disc, quad
 from demcal.decks.render import render_deck, write_case_directory
 from demcal.decks.triangle_surface import merge
 from demcal.particles.material import material_record, material_setup
@@ -34,6 +34,7 @@ from demcal.virtual_tests.shear_cell.setup import (
 __all__ = [
     "DECK_NAMES",
     "REPOSE_FILES",
+    "RING_FILES",
     "SHEAR_FILES",
     "TESTS",
     "render_case",
@@ -48,6 +49,16 @@ SHEAR_FILES = {
     "upper": "meshes/shear_upper.stl",
     "upper_flange": "meshes/shear_upper_flange.stl",
     "lid": "meshes/shear_lid.stl",
+    "table": "shear_cell.txt",
+    "snapshot": "shear_preshear_end.vtk",
+    "contacts": "contacts.dump",
+}
+RING_FILES = {
+    "lower": "meshes/ring_lower.stl",
+    "lower_inner": "meshes/ring_lower_inner.stl",
+    "upper": "meshes/ring_upper.stl",
+    "upper_inner": "meshes/ring_upper_inner.stl",
+    "lid": "meshes/ring_lid.stl",
     "table": "shear_cell.txt",
     "snapshot": "shear_preshear_end.vtk",
     "contacts": "contacts.dump",
@@ -137,6 +148,43 @@ def _shear_meshes(s: ShearCellSetup) -> dict[str, np.ndarray]:
     }
 
 
+def _bars(s: ShearCellSetup, z0: float, z1: float) -> np.ndarray:
+    """Radial plates from R_i to R between the heights z0 and z1, evenly spaced."""
+    plates = []
+    for k in range(s.n_bars):
+        # Half a spacing off the polygon vertices at angle 0.
+        angle = 2.0 * math.pi * (k + 0.5) / s.n_bars
+        c, d = math.cos(angle), math.sin(angle)
+        inner = (s.inner_radius * c, s.inner_radius * d)
+        outer = (s.radius * c, s.radius * d)
+        corners = [(*inner, z0), (*outer, z0), (*outer, z1), (*inner, z1)]
+        plates.append(quad(*(np.array(p, dtype=float) for p in corners)))
+    return merge(*plates)
+
+
+def _ring_meshes(s: ShearCellSetup) -> dict[str, np.ndarray]:
+    n = s.n_segments
+    r, ri = s.radius, s.inner_radius
+    lower = [
+        annulus(ri, r, 0.0, n, normal_up=True),
+        cylinder_shell(r, 0.0, s.z_shear, n, normals="inward"),
+    ]
+    lid = [annulus(ri, r, 0.0, n, normal_up=False)]
+    if s.n_bars and s.bar_height > 0.0:
+        lower.append(_bars(s, 0.0, s.bar_height))
+        lid.append(_bars(s, -s.bar_height, 0.0))
+    # The inner bands are meshes of their own: they join the walls only once the core has
+    # been emptied after the insertion.
+    return {
+        "lower": merge(*lower),
+        "lower_inner": cylinder_shell(ri, 0.0, s.z_shear, n, normals="outward"),
+        "upper": cylinder_shell(r, s.z_shear, s.wall_top, n, normals="inward"),
+        "upper_inner": cylinder_shell(ri, s.z_shear, s.wall_top, n, normals="outward"),
+        # The lid is placed by the deck (`move`) with its bars just above the settled bed.
+        "lid": merge(*lid),
+    }
+
+
 def _repose_meshes(s: ReposeSetup) -> dict[str, np.ndarray]:
     return {
         "plate": disc(s.plate_radius, 0.0, s.n_segments, normal_up=True),
@@ -220,11 +268,18 @@ def render_case(
         setup: ShearCellSetup | ReposeSetup = shear_cell_setup(
             dCylDp, float(plain["normal_stress"]), dist, mat, cell, seed, skin
         )
-        files = dict(SHEAR_FILES)
-        meshes = _shear_meshes(setup)
-        template = "shear_cell.in.j2"
+        if setup.geometry == "ring":
+            files = dict(RING_FILES)
+            meshes = _ring_meshes(setup)
+            template = "ring_shear_cell.in.j2"
+        else:
+            files = dict(SHEAR_FILES)
+            meshes = _shear_meshes(setup)
+            template = "shear_cell.in.j2"
         readout: dict[str, Any] = {
+            "geometry": setup.geometry,
             "radius": setup.radius,
+            "inner_radius": setup.inner_radius,
             "z_floor": 0.0,
             "z_shear": setup.z_shear,
             "gravity": GRAVITY,

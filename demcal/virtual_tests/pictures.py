@@ -26,7 +26,7 @@ from demcal.virtual_tests.angle_of_repose.readout import angle_of_repose
 from demcal.virtual_tests.shear_cell.readout import (
     PHASE_PRE_SHEAR,
     PHASE_SHEAR,
-    REQUIRED_COLUMNS,
+    required_columns,
     shear_stress_series,
 )
 
@@ -200,13 +200,24 @@ def shear_cell_picture(case_dir: Path, png: Path) -> Path:
         clim=(0.0, 1.5 * float(setup["shear_speed"])),
         scalar_bar_args=_BAR | {"title": "particle speed (m/s)"},
     )
+    # The ring's lower part turns in place (drawn at its starting angle).
+    split = setup.get("geometry", "split") == "split"
+    shift = travel if split else 0.0
+    moved = "offset" if split else "travel at the mean radius"
     walls = {
-        "lower": (travel, 0.0, 0.0),
-        "lower_flange": (travel, 0.0, 0.0),
+        "lower": (shift, 0.0, 0.0),
+        "lower_flange": (shift, 0.0, 0.0),
+        "lower_inner": (0.0, 0.0, 0.0),
         "upper": (0.0, 0.0, 0.0),
         "upper_flange": (0.0, 0.0, 0.0),
+        "upper_inner": (0.0, 0.0, 0.0),
     }
-    colours = {"lower": "steelblue", "lower_flange": "steelblue", "upper": "gray"}
+    colours = {
+        "lower": "steelblue",
+        "lower_flange": "steelblue",
+        "lower_inner": "steelblue",
+        "upper": "gray",
+    }
     for name, offset in walls.items():
         if name not in files:  # a case rendered before the flanges were meshes of their own
             continue
@@ -229,7 +240,7 @@ def shear_cell_picture(case_dir: Path, png: Path) -> Path:
     )
     text = (
         f"case {record['case_id']}: end of pre-shear, normal stress "
-        f"{float(setup['normal_stress']):.0f} Pa, offset {1e3 * travel:.2f} mm, "
+        f"{float(setup['normal_stress']):.0f} Pa, {moved} {1e3 * travel:.2f} mm, "
         f"lid at {1e3 * lid_z:.1f} mm, {len(vtk.points)} particles"
     )
     plotter.add_text(text, font_size=10, color="black")
@@ -361,8 +372,9 @@ def mu_series_figure(case_dir: Path, png: Path) -> Path:
     case_dir = Path(case_dir)
     record = _record(case_dir, "shear_cell")
     readout, setup = record["readout"], record["setup"]
+    inner = float(readout.get("inner_radius", 0.0))
     table = read_print_file(
-        _existing(case_dir, record["files"]["table"]), columns=list(REQUIRED_COLUMNS)
+        _existing(case_dir, record["files"]["table"]), columns=list(required_columns(inner))
     )
     series = shear_stress_series(
         table,
@@ -370,6 +382,7 @@ def mu_series_figure(case_dir: Path, png: Path) -> Path:
         float(readout["z_floor"]),
         float(readout["z_shear"]),
         float(readout["gravity"]),
+        inner,
     )
     values = extract("shear_cell", case_dir)
     p_values = ", ".join(f"{float(p):g}" for p in values["P"])

@@ -438,3 +438,55 @@ def test_validate_config_defaults_cover_the_new_sections() -> None:
     assert cfg["shear_cell"]["P"] == [0.4, 0.6, 0.8, 1.0]
     assert cfg["material"]["youngsModulus"] == 1.0e7
     assert cfg["angle_of_repose"]["lift_height"] == 1.2
+
+
+def ring() -> dict:
+    """The tiny configuration with the ring shear cell (6 particle diameters wide)."""
+    cfg = tiny()
+    cfg["shear_cell"].update(geometry="ring", dCylDp=24, fill_height=0.5, overfill=0.15)
+    return cfg
+
+
+def test_ring_deck_turns_the_lower_part_and_reads_the_torque(tmp_path: Path) -> None:
+    record = render_case("shear_cell", {**CASE, "P": 0.6}, ring(), tmp_path)
+    s = record["setup"]
+    deck = (tmp_path / "in.shear_cell").read_text()
+    assert f"target_val {format_number(-s['preshear_force'])} " in deck
+    # Core emptied after the one insertion step, before the inner bands join the walls.
+    core = deck.index(f"region core cylinder z 0.0 0.0 {format_number(s['core_radius'])} ")
+    assert deck.index("run 1\n") < core < deck.index("meshes lower lowerin upper upperin\n")
+    # Pre-shear and shear turn floor and lower bands about z; the held parts carry the torque.
+    turns = re.findall(
+        r"fix turn all move/mesh mesh lower rotate .* axis 0.0 0.0 (\S+) period (\S+)", deck
+    )
+    assert len(turns) == 2 == deck.count("fix turnin all move/mesh mesh lowerin rotate")
+    for sign, period in turns:
+        assert float(sign) == -1.0
+        assert float(period) == pytest.approx(2 * math.pi * s["mean_radius"] / s["shear_speed"])
+    assert "variable torque equal f_lid[6]+f_upper[6]+f_upperin[6]\n" in deck
+    assert record["readout"]["inner_radius"] == pytest.approx(s["radius"] / 2)
+
+
+def test_ring_meshes_have_the_cell_geometry(tmp_path: Path) -> None:
+    record = render_case("shear_cell", CASE, ring(), tmp_path)
+    s = record["setup"]
+    n, bars = s["n_segments"], s["n_bars"]
+    ring_area = 0.5 * n * (s["radius"] ** 2 - s["inner_radius"] ** 2) * math.sin(2 * math.pi / n)
+    lid = read_stl(tmp_path / "meshes" / "ring_lid.stl").triangles
+    # Annulus plus one radial plate (two triangles) per bar, hanging below the lid plane.
+    assert len(lid) == 2 * n + 2 * bars
+    plates = (s["radius"] - s["inner_radius"]) * s["bar_height"] * bars
+    assert surface_area(lid) == pytest.approx(ring_area + plates, rel=1e-9)
+    assert lid[..., 2].min() == pytest.approx(-s["bar_height"]) and lid[..., 2].max() == 0.0
+    lower = read_stl(tmp_path / "meshes" / "ring_lower.stl").triangles
+    assert lower[..., 2].max() == pytest.approx(s["z_shear"])
+    reach = np.hypot(lower[..., 0], lower[..., 1])
+    assert reach.min() == pytest.approx(s["inner_radius"]) and reach.max() == pytest.approx(
+        s["radius"]
+    )
+    for name, r in (("ring_lower_inner.stl", s["inner_radius"]), ("ring_upper.stl", s["radius"])):
+        band = read_stl(tmp_path / "meshes" / name).triangles
+        assert np.hypot(band[..., 0], band[..., 1]).max() == pytest.approx(r)
+    upper_in = read_stl(tmp_path / "meshes" / "ring_upper_inner.stl").triangles
+    assert upper_in[..., 2].min() == pytest.approx(s["z_shear"])
+    assert upper_in[..., 2].max() == pytest.approx(s["wall_top"])

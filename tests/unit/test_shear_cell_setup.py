@@ -337,3 +337,59 @@ def test_missing_key_is_named() -> None:
 def test_non_positive_stress_is_rejected() -> None:
     with pytest.raises(SetupError, match="normal_stress"):
         setup_for(stress=0.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# ring cell
+
+RING = {"geometry": "ring", "fill_height": 0.5, "overfill": 0.15, "ring_radius_ratio": 2.0}
+
+
+def test_ring_geometry_force_and_rotation() -> None:
+    s, _, _ = setup_for(dCylDp=24.0, **RING)
+    assert s.geometry == "ring"
+    assert s.radius == pytest.approx(0.024)
+    assert s.inner_radius == pytest.approx(0.012)
+    assert s.mean_radius == pytest.approx(0.018)
+    # Inner polygon vertices on R_i; a centre 1.05 r_max further out clears it.
+    assert s.core_radius == pytest.approx(0.012 + 1.05e-3)
+    assert s.cross_section == pytest.approx(math.pi * (0.024**2 - 0.012**2))
+    assert s.preshear_force == pytest.approx(2029.0 * math.pi * (0.024**2 - 0.012**2))
+    assert (s.n_bars, s.bar_height) == (24, pytest.approx(2e-3))
+    # The lid starts with its bars one particle radius (and 5 %) above the bed.
+    assert s.lid_gap == pytest.approx(1.05e-3 + 2e-3)
+    assert s.wall_top >= s.fill_height + s.lid_gap + 2e-3
+    # The ring turns in place: the box is the cell plus a margin, no flange.
+    assert s.flange_width == 0.0
+    assert s.box_hi[0] == pytest.approx(0.024 + 4e-3) and s.box_lo[1] == pytest.approx(-0.028)
+    assert len(s.rotation) == len(s.segments)
+    for seg, (period, sign) in zip(s.segments, s.rotation, strict=True):
+        if seg.moving:
+            # One turn of the mean circle at the shear speed; sign of the turning sense.
+            assert period == pytest.approx(2 * math.pi * 0.018 / abs(seg.velocity))
+            assert sign == (1 if seg.velocity > 0 else -1)
+        else:
+            assert (period, sign) == (0.0, 0)
+    assert s.settle_steps == s.fill_steps - 1
+
+
+def test_split_cell_has_no_ring_fields() -> None:
+    s, _, _ = setup_for(dCylDp=24.0)
+    assert (s.geometry, s.inner_radius, s.n_bars, s.rotation) == ("split", 0.0, 0, ())
+    assert s.cross_section == pytest.approx(math.pi * 0.024**2)
+
+
+@pytest.mark.parametrize(
+    ("dCylDp", "cell", "match"),
+    [
+        # R = 8 mm at ratio 1.2: a ring 1.3 mm wide, narrower than three particle diameters
+        (8.0, {**RING, "ring_radius_ratio": 1.2}, "ring_radius_ratio"),
+        (24.0, {**RING, "ring_radius_ratio": 1.0}, "ring_radius_ratio"),
+        (24.0, {**RING, "bar_height": 6.0}, "bar_height"),
+        (24.0, {**RING, "n_bars": -1}, "n_bars"),
+        (24.0, {**RING, "geometry": "box"}, "geometry"),
+    ],
+)
+def test_bad_ring_settings_name_the_key(dCylDp: float, cell: dict, match: str) -> None:
+    with pytest.raises(SetupError, match=match):
+        setup_for(dCylDp=dCylDp, **cell)

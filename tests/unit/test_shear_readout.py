@@ -167,24 +167,24 @@ CYCLES = [
 ]
 
 
+def one_row(lid_z: float, lid_force: float, **columns: float) -> pd.DataFrame:
+    """A one-row pre-shear table at a lid target of 10 N with the given columns."""
+    base = {"time": 1.0, "phase": 1, "cycle": 0, "lid_z": lid_z, "lid_force": lid_force}
+    return pd.DataFrame({k: [v] for k, v in {**base, "target_force": 10.0, **columns}.items()})
+
+
 def test_stress_series_by_hand() -> None:
     # One row with round numbers: rho_b = 1500 kg/m^3 by construction.
     lid_z, travel, lid_force, shear = 0.03, 0.004, 10.0, -6.0
     upper_z, flange_z = 2.5, -0.5
-    row = pd.DataFrame(
-        {
-            "time": [1.0],
-            "phase": [1],
-            "cycle": [0],
-            "lid_z": [lid_z],
-            "lid_force": [lid_force],
-            "shear_force": [shear],
-            "travel": [travel],
-            "mass": [1500.0 * AREA * lid_z],
-            "target_force": [10.0],
-            "upper_force_z": [upper_z],
-            "lower_flange_force_z": [flange_z],
-        }
+    row = one_row(
+        lid_z,
+        lid_force,
+        shear_force=shear,
+        travel=travel,
+        mass=1500.0 * AREA * lid_z,
+        upper_force_z=upper_z,
+        lower_flange_force_z=flange_z,
     )
     out = shear_stress_series(row, R, Z_FLOOR, Z_SHEAR, G).iloc[0]
     area = 2 * R**2 * np.arccos(travel / (2 * R)) - travel / 2 * np.sqrt(4 * R**2 - travel**2)
@@ -295,3 +295,74 @@ def test_bad_tables_raise_clear_errors() -> None:
         shear_cell_bulk_values(holes, R, Z_FLOOR, Z_SHEAR)
     with pytest.raises(ValueError, match="z_shear"):
         shear_cell_bulk_values(table, R, Z_SHEAR, Z_FLOOR)
+
+
+# ---------------------------------------------------------------------------------------------
+# ring cell: torque readout over a fixed annular shear plane
+
+R_IN = 0.01  # inner radius of the ring cell, m
+RING_AREA = np.pi * (R**2 - R_IN**2)
+
+
+def ring_table(table: pd.DataFrame) -> pd.DataFrame:
+    """The split-cell synthetic run as the ring prints it: the same normal force across the
+    plane, and the torque that a uniform shear stress mu * sigma over the annulus gives."""
+    ring = table.drop(columns=["shear_force", "lower_flange_force_z"]).copy()
+    # Same solid fraction over the annulus: the mass scales with the cross-section.
+    ring["mass"] = table["mass"] * RING_AREA / AREA
+    weight = ring["mass"] * G * (ring["lid_z"] - Z_SHEAR) / (ring["lid_z"] - Z_FLOOR)
+    normal = ring["lid_force"] + weight + ring["upper_force_z"]
+    mu = np.abs(table["shear_force"]) / (
+        table["lid_force"]
+        + table["mass"] * G * (table["lid_z"] - Z_SHEAR) / (table["lid_z"] - Z_FLOOR)
+        + table["upper_force_z"]
+        + table["lower_flange_force_z"]
+    )
+    ring["torque"] = mu * normal / RING_AREA * 2.0 * np.pi * (R**3 - R_IN**3) / 3.0
+    return ring
+
+
+def test_ring_stress_series_by_hand() -> None:
+    lid_z, lid_force, upper_z, torque = 0.03, 10.0, 2.5, 0.04
+    row = one_row(
+        lid_z,
+        lid_force,
+        torque=-torque,
+        travel=0.5,  # arc length at the mean radius: no limit in the ring
+        mass=1500.0 * RING_AREA * lid_z,
+        upper_force_z=upper_z,
+    )
+    out = shear_stress_series(row, R, Z_FLOOR, Z_SHEAR, G, inner_radius=R_IN).iloc[0]
+    assert out["rho_b"] == pytest.approx(1500.0, rel=1e-12)
+    assert out["area"] == pytest.approx(RING_AREA, rel=1e-12)
+    normal = lid_force + 1500.0 * G * RING_AREA * (lid_z - Z_SHEAR) + upper_z
+    assert out["sigma"] == pytest.approx(normal / RING_AREA, rel=1e-12)
+    # Uniform tau over the annulus: T = tau * 2 pi (R^3 - R_i^3) / 3.
+    tau = 3.0 * torque / (2.0 * np.pi * (R**3 - R_IN**3))
+    assert out["tau"] == pytest.approx(tau, rel=1e-12)
+    assert out["mu"] == pytest.approx(tau * RING_AREA / normal, rel=1e-12)
+
+
+def test_ring_bulk_values_recovered_per_cycle() -> None:
+    values = shear_cell_bulk_values(
+        ring_table(synthetic_run(CYCLES, seed=4)), R, Z_FLOOR, Z_SHEAR, G, inner_radius=R_IN
+    )
+    for spec, row in zip(CYCLES, values.itertuples(), strict=True):
+        assert row.mu_psh == pytest.approx(spec["mu_psh"], abs=0.01)
+        assert row.mu_sh == pytest.approx(spec["mu_sh"], abs=0.01)
+        assert row.rho_b == pytest.approx(spec["rho_b"], rel=1e-3)
+        # The target force is a stress on the annulus, not on the full disc.
+        assert row.normal_stress == pytest.approx(spec["normal_stress"] * AREA / RING_AREA)
+
+
+def test_ring_readout_needs_the_torque_and_a_valid_inner_radius() -> None:
+    table = ring_table(synthetic_run(CYCLES[:1]))
+    with pytest.raises(MissingColumnError, match="torque"):
+        shear_stress_series(
+            table.drop(columns=["torque"]), R, Z_FLOOR, Z_SHEAR, G, inner_radius=R_IN
+        )
+    with pytest.raises(ValueError, match="inner_radius"):
+        shear_stress_series(table, R, Z_FLOOR, Z_SHEAR, G, inner_radius=R)
+    # The split cell's columns are not what a ring table holds.
+    with pytest.raises(MissingColumnError, match="shear_force"):
+        shear_stress_series(table, R, Z_FLOOR, Z_SHEAR, G)

@@ -39,6 +39,13 @@ flange. Then
 * ``rho_b = mass / (pi R^2 (lid_z - z_floor))``,
 * ``sigma = N / A`` and ``tau = |shear_force| / A``, ``mu = tau / sigma``.
 
+The ring cell (``shear_cell.geometry: ring``, radii ``R_i`` and ``R``) prints ``torque``, the
+torque about the cell axis of the particles on the held parts (lid and upper bands), instead
+of ``shear_force``, and ``upper_force_z`` covers both upper bands; it has no flanges. Its shear
+plane is the annulus ``A = pi (R^2 - R_i^2)`` at every travel, the normal force is
+``N = lid_force + rho_b g A (lid_z - z_shear) + upper_force_z`` as above, and the torque, with
+the shear stress taken uniform over the plane, gives ``tau = 3 |torque| / (2 pi (R^3 - R_i^3))``.
+
 ``mu_psh`` and ``mu_sh`` are the means of ``mu`` over the steady plateaus detected (by
 :func:`demcal.core.steady_state.detect_plateau`) in the pre-shear and the shear phase of a
 cycle;
@@ -63,7 +70,9 @@ __all__ = [
     "PHASE_SHEAR",
     "PHASE_UNLOAD",
     "REQUIRED_COLUMNS",
+    "RING_COLUMNS",
     "overlap_area",
+    "required_columns",
     "shear_cell_bulk_values",
     "shear_stress_series",
 ]
@@ -87,7 +96,26 @@ REQUIRED_COLUMNS: tuple[str, ...] = (
     "lower_flange_force_z",
 )
 
+RING_COLUMNS: tuple[str, ...] = (
+    "time",
+    "phase",
+    "cycle",
+    "lid_z",
+    "lid_force",
+    "torque",
+    "travel",
+    "mass",
+    "target_force",
+    "upper_force_z",
+)
+
 _SOURCE = "shear-cell table"
+
+
+def required_columns(inner_radius: float | None = None) -> tuple[str, ...]:
+    """Print-file columns the readout needs: the split cell's, or the ring's when
+    ``inner_radius`` (m) is given and positive."""
+    return RING_COLUMNS if inner_radius else REQUIRED_COLUMNS
 
 
 def overlap_area(radius: float, travel: float | np.ndarray) -> float | np.ndarray:
@@ -125,13 +153,18 @@ def overlap_area(radius: float, travel: float | np.ndarray) -> float | np.ndarra
     return float(area) if area.ndim == 0 else area
 
 
-def _validated(table: pd.DataFrame, radius: float, z_floor: float, z_shear: float) -> None:
-    require_columns(list(table.columns), REQUIRED_COLUMNS, _SOURCE)
+def _validated(
+    table: pd.DataFrame, radius: float, z_floor: float, z_shear: float, inner_radius: float | None
+) -> None:
+    columns = required_columns(inner_radius)
+    require_columns(list(table.columns), columns, _SOURCE)
     if not radius > 0.0:
         raise ValueError(f"radius must be positive, got {radius}")
+    if inner_radius is not None and not 0.0 <= inner_radius < radius:
+        raise ValueError(f"inner_radius must lie in [0, radius), got {inner_radius}")
     if not z_shear > z_floor:
         raise ValueError(f"z_shear ({z_shear}) must lie above z_floor ({z_floor})")
-    for name in REQUIRED_COLUMNS:
+    for name in columns:
         values = pd.to_numeric(table[name], errors="coerce").to_numpy(dtype=np.float64)
         bad = ~np.isfinite(values)
         if bad.any():
@@ -148,6 +181,8 @@ def _validated(table: pd.DataFrame, radius: float, z_floor: float, z_shear: floa
             f"{_SOURCE}: column 'lid_z' = {lid_z[row]} is not above the shear plane "
             f"z_shear = {z_shear} in row {row}"
         )
+    if inner_radius:
+        return
     travel = np.abs(table["travel"].to_numpy(dtype=np.float64))
     far = sheared & (travel >= 2.0 * radius)
     if far.any():
@@ -164,6 +199,7 @@ def shear_stress_series(
     z_floor: float,
     z_shear: float,
     g: float = GRAVITY,
+    inner_radius: float | None = None,
 ) -> pd.DataFrame:
     """Add the time series of area, bulk density, stresses and mu to a shear-cell table.
 
@@ -179,6 +215,8 @@ def shear_stress_series(
         Height of the shear plane (m).
     g : float
         Gravitational acceleration (m/s^2).
+    inner_radius : float, optional
+        Inner radius R_i of the ring cell (m); None or 0 for the split cell.
 
     Returns
     -------
@@ -194,24 +232,28 @@ def shear_stress_series(
         Non-finite values, a lid at or below the shear plane, or a travel of 2R or more
         during pre-shear or shear.
     """
-    _validated(table, radius, z_floor, z_shear)
+    _validated(table, radius, z_floor, z_shear, inner_radius)
     out = table.copy()
-    column = {name: out[name].to_numpy(dtype=np.float64) for name in REQUIRED_COLUMNS}
-    cross_section = np.pi * radius**2
+    ring = bool(inner_radius)
+    column = {name: out[name].to_numpy(dtype=np.float64) for name in required_columns(inner_radius)}
+    r_in = float(inner_radius) if ring else 0.0
+    cross_section = np.pi * (radius**2 - r_in**2)
     lid_z = column["lid_z"]
-    area = np.asarray(overlap_area(radius, column["travel"]))
+    if ring:
+        area = np.full(len(out), cross_section)
+    else:
+        area = np.asarray(overlap_area(radius, column["travel"]))
     with np.errstate(divide="ignore", invalid="ignore"):
         # Settling and unloading rows may have a lid near the floor; only phases 1 and 3 count.
         rho_b = column["mass"] / (cross_section * (lid_z - z_floor))
         weight_above = rho_b * g * cross_section * (lid_z - z_shear)
-        normal = (
-            column["lid_force"]
-            + weight_above
-            + column["upper_force_z"]
-            + column["lower_flange_force_z"]
-        )
+        normal = column["lid_force"] + weight_above + column["upper_force_z"]
+        if ring:
+            tau = 3.0 * np.abs(column["torque"]) / (2.0 * np.pi * (radius**3 - r_in**3))
+        else:
+            normal = normal + column["lower_flange_force_z"]
+            tau = np.abs(column["shear_force"]) / area
         sigma = normal / area
-        tau = np.abs(column["shear_force"]) / area
         mu = tau / sigma
     out["area"] = area
     out["rho_b"] = rho_b
@@ -240,6 +282,7 @@ def shear_cell_bulk_values(
     z_floor: float,
     z_shear: float,
     g: float = GRAVITY,
+    inner_radius: float | None = None,
     **plateau_kwargs: Any,
 ) -> pd.DataFrame:
     """Bulk values of every pre-shear/shear cycle of a shear-cell run.
@@ -256,6 +299,8 @@ def shear_cell_bulk_values(
         Height of the shear plane (m).
     g : float
         Gravitational acceleration (m/s^2).
+    inner_radius : float, optional
+        Inner radius R_i of the ring cell (m); None or 0 for the split cell.
     **plateau_kwargs
         Passed on to :func:`demcal.core.steady_state.detect_plateau` (e.g.
         ``min_fraction``).
@@ -278,8 +323,8 @@ def shear_cell_bulk_values(
         Invalid geometry or table values (see :func:`shear_stress_series`), a non-positive
         pre-shear target force, or time running backwards within a phase.
     """
-    series = shear_stress_series(table, radius, z_floor, z_shear, g)
-    cross_section = np.pi * radius**2
+    series = shear_stress_series(table, radius, z_floor, z_shear, g, inner_radius)
+    cross_section = np.pi * (radius**2 - (inner_radius or 0.0) ** 2)
     records = []
     phase = series["phase"].to_numpy()
     cycles = np.unique(series["cycle"].to_numpy()[np.isin(phase, [PHASE_PRE_SHEAR, PHASE_SHEAR])])

@@ -14,6 +14,18 @@ the fixed upper ring is the upper tube and a flange at the same height. The flan
 crescents that open between the two tubes when they are offset, so no particle leaves the cell
 through the split. The lid is a disc of radius ``R`` on a force servo.
 
+Ring geometry (``shear_cell.geometry: ring``)
+---------------------------------------------
+An annular cell between the radii ``R_i = R / ring_radius_ratio`` and ``R``, split
+horizontally at ``z_shear`` instead of across the axis: the lower part (floor with
+``n_bars`` radial bars of height ``bar_height * r_ref`` and both walls up to the shear plane)
+rotates about the z axis, the upper bands of both walls and the lid (with the same bars
+hanging down) are held. The shear plane keeps its area while the lower part turns, so no
+crescent opens and no particle is pinched between a moving and a fixed edge. The speed and
+the travel are those at the mean radius ``(R + R_i) / 2``. The core inside ``R_i`` is filled
+like the rest and its particles are deleted right after the insertion, before the inner wall
+joins the walls.
+
 Filling: ``N = packing_fraction * pi R^2 (h_fill + overfill R) / v_p`` particles (``v_p`` the
 number-weighted mean particle volume) are inserted at a lower volume fraction into a taller
 cylinder, fall and settle; the bed is scraped level at ``h_fill`` (particles above are deleted,
@@ -135,7 +147,7 @@ class ShearCellSetup(RunSetup):
     insertion_radius, insertion_zlo, insertion_zhi : float
         Insertion cylinder, m.
     lid_gap : float
-        Lid start height above the highest particle centre, m.
+        Lid start height above the highest particle centre, m (ring: plus the bar height).
     normal_stress : float
         Pre-shear normal stress, Pa.
     preshear_force : float
@@ -162,6 +174,22 @@ class ShearCellSetup(RunSetup):
     contact_dump_every : int
         Steps between contact snapshots (``shear_cell.contact_snapshots`` per pre-shear), 0 for
         none.
+    geometry : str
+        "split" (split cylinder) or "ring" (annular cell, see the module docstring).
+    inner_radius : float
+        Ring: radius R_i of the inner wall, m (0 for the split cell).
+    core_radius : float
+        Ring: particles with centres closer than this to the axis are deleted after the
+        insertion, m.
+    mean_radius : float
+        Ring: (R + R_i) / 2, where speed and travel are taken, m.
+    n_bars : int
+        Ring: radial bars on the floor and under the lid.
+    bar_height : float
+        Ring: height of the bars, m.
+    rotation : tuple of (float, int)
+        Ring: per segment the period of the lower part's rotation (s, 0 at rest) and the sign
+        of the rotation axis (+1 anticlockwise seen from above).
     """
 
     radius: float
@@ -197,11 +225,23 @@ class ShearCellSetup(RunSetup):
     unload_time: float
     inertial_number_min_stress: float
     contact_dump_every: int = 0
+    geometry: str = "split"
+    inner_radius: float = 0.0
+    core_radius: float = 0.0
+    mean_radius: float = 0.0
+    n_bars: int = 0
+    bar_height: float = 0.0
+    rotation: tuple[tuple[float, int], ...] = ()
+
+    @property
+    def settle_steps(self) -> int:
+        """Ring: steps of the settling after the one step that inserts the particles."""
+        return self.fill_steps - 1
 
     @property
     def cross_section(self) -> float:
-        """Cell cross-section pi R^2, m^2."""
-        return math.pi * self.radius**2
+        """Cell cross-section pi (R^2 - R_i^2), m^2 (R_i = 0 for the split cell)."""
+        return math.pi * (self.radius**2 - self.inner_radius**2)
 
     def as_dict(self) -> dict[str, Any]:
         """Plain JSON-ready dict (segments and cycles as lists of dicts)."""
@@ -271,9 +311,15 @@ def shear_cell_setup(
         raise SetupError(
             f"configuration: 'shear_cell.cycles' must be 'alternate' or 'return', got {mode!r}"
         )
+    geometry = _get(cell, "geometry", where)
+    if geometry not in ("split", "ring"):
+        raise SetupError(
+            f"configuration: 'shear_cell.geometry' must be 'split' or 'ring', got {geometry!r}"
+        )
     r_ref = dist.mass_mean_radius
     r_max = dist.max_radius
     radius = float(dCylDp) * r_ref
+    ring = _ring_geometry(cell, radius, r_ref, r_max) if geometry == "ring" else None
     n_seg = int(_get(cell, "n_segments", where))
     if n_seg < 12:
         raise SetupError(f"configuration: 'shear_cell.n_segments' must be >= 12, got {n_seg}")
@@ -301,7 +347,18 @@ def shear_cell_setup(
     ins_zlo = 1.05 * r_max
     ins_zhi = ins_zlo + solid / (phi_ins * math.pi * ins_radius**2)
     wall_top = ins_zhi + 2.0 * r_max
+    if ring is not None:
+        # The lid starts above the scraped bed with its bars clear of the particles.
+        wall_top = max(wall_top, fill_height + ring.bar_height + 3.05 * r_max)
     z_shear = shear_plane * fill_height
+    if ring is not None:
+        clear = ring.bar_height + 2.0 * r_max
+        if min(z_shear, fill_height - z_shear) < clear:
+            raise SetupError(
+                f"configuration: the bars ({ring.bar_height:.4g} m) reach within one particle "
+                f"diameter of the shear plane at {z_shear:.4g} m in a bed {fill_height:.4g} m "
+                f"high; raise '{where}.fill_height' or lower '{where}.bar_height'"
+            )
 
     dt = material.timestep
     skin = skin_factor * dist.min_radius
@@ -328,7 +385,8 @@ def shear_cell_setup(
     if min(kp, ki, kd) < 0.0 or kp + ki + kd <= 0.0:
         raise SetupError("configuration: servo_kp, servo_ki, servo_kd must be >= 0, not all 0")
 
-    force = normal_stress * math.pi * radius**2
+    inner = ring.inner_radius if ring is not None else 0.0
+    force = normal_stress * math.pi * (radius**2 - inner**2)
     p_values = _p_values(_get(cell, "P", where))
 
     # Free fall from the top of the insertion region, then settling.
@@ -360,10 +418,22 @@ def shear_cell_setup(
     )
     cycles = schedule.cycles
     max_offset = schedule.max_offset
-    flange = max_offset + 4.0 * r_max
     margin = 4.0 * r_max
-    half_x = radius + flange + max_offset + margin
-    half_y = radius + flange + margin
+    if ring is None:
+        flange = max_offset + 4.0 * r_max
+        half_x = radius + flange + max_offset + margin
+        half_y = radius + flange + margin
+        rotation: tuple[tuple[float, int], ...] = ()
+    else:
+        # The ring turns in place: no flange, no offset.
+        flange = 0.0
+        half_x = half_y = radius + margin
+        rotation = tuple(
+            (2.0 * math.pi * ring.mean_radius / abs(g.velocity), 1 if g.velocity > 0 else -1)
+            if g.moving
+            else (0.0, 0)
+            for g in schedule.segments
+        )
     box_lo = (-half_x, -half_y, -margin)
     box_hi = (half_x, half_y, wall_top + margin)
 
@@ -396,7 +466,7 @@ def shear_cell_setup(
         insertion_zhi=ins_zhi,
         box_lo=box_lo,
         box_hi=box_hi,
-        lid_gap=1.05 * r_max,
+        lid_gap=1.05 * r_max + (ring.bar_height if ring is not None else 0.0),
         normal_stress=float(normal_stress),
         preshear_force=force,
         lid_target_val=-force,
@@ -420,4 +490,52 @@ def shear_cell_setup(
         inertial_number_min_stress=inertial_number(speed, 10.0, smallest_stress, material.density),
         contact_dump_every=max(1, n_psh // snapshots) if snapshots else 0,
         seeds=insertion_seeds(seed, dist.n_classes),
+        geometry=geometry,
+        inner_radius=inner,
+        core_radius=ring.core_radius if ring is not None else 0.0,
+        mean_radius=ring.mean_radius if ring is not None else 0.0,
+        n_bars=ring.n_bars if ring is not None else 0,
+        bar_height=ring.bar_height if ring is not None else 0.0,
+        rotation=rotation,
+    )
+
+
+@dataclass(frozen=True)
+class _Ring:
+    inner_radius: float
+    core_radius: float
+    mean_radius: float
+    n_bars: int
+    bar_height: float
+
+
+def _ring_geometry(cell: Mapping[str, Any], radius: float, r_ref: float, r_max: float) -> _Ring:
+    """Radii and bars of the annular cell (lengths in m), checked against the particle size."""
+    where = "shear_cell"
+    ratio = float(_get(cell, "ring_radius_ratio", where))
+    if not (math.isfinite(ratio) and ratio > 1.0):
+        raise SetupError(
+            f"configuration: '{where}.ring_radius_ratio' must be > 1 (outer over inner radius), "
+            f"got {ratio!r}"
+        )
+    inner = radius / ratio
+    if radius - inner < 6.0 * r_max:
+        raise SetupError(
+            f"configuration: the ring is {radius - inner:.4g} m wide, less than three largest "
+            f"particle diameters ({6.0 * r_max:.4g} m); raise 'shear_cell.dCylDp' or lower "
+            f"'{where}.ring_radius_ratio'"
+        )
+    n_bars = int(_get(cell, "n_bars", where))
+    if n_bars < 0:
+        raise SetupError(f"configuration: '{where}.n_bars' must be >= 0, got {n_bars}")
+    bar_height = float(_get(cell, "bar_height", where)) * r_ref
+    if not (math.isfinite(bar_height) and bar_height >= 0.0):
+        raise SetupError(f"configuration: '{where}.bar_height' must be >= 0, got {bar_height!r}")
+    return _Ring(
+        inner_radius=inner,
+        # Vertices of the inner polygon lie on R_i: a centre this far out cannot touch it.
+        core_radius=inner + 1.05 * r_max,
+        mean_radius=0.5 * (radius + inner),
+        n_bars=n_bars,
+        bar_height=bar_height,
     )
