@@ -1,4 +1,5 @@
-"""The decks the fuzzer mutates: the tiny profile's shear cell, angle of repose and chute cooler."""
+"""The decks the fuzzer mutates: the tiny profile's shear cell (split and ring), angle of
+repose and chute cooler."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ from demcal.virtual_tests.deck import DECK_NAMES, render_case
 
 
 def render_base_decks(work_dir: Path, config: Path | None = None) -> list[BaseDeck]:
-    """Render the tiny shear cell, angle of repose and chute cooler decks into ``work_dir``.
+    """Render the tiny shear cells, angle of repose and chute cooler decks into ``work_dir``.
 
     Parameters
     ----------
@@ -24,7 +25,8 @@ def render_base_decks(work_dir: Path, config: Path | None = None) -> list[BaseDe
     Returns
     -------
     list of BaseDeck
-        The three decks, in the order shear cell, angle of repose, chute cooler.
+        The four decks, in the order split shear cell, ring shear cell, angle of repose,
+        chute cooler.
     """
     root = Path(__file__).resolve().parents[2]
     config = config or root / "config" / "tiny.yaml"
@@ -40,6 +42,10 @@ def render_base_decks(work_dir: Path, config: Path | None = None) -> list[BaseDe
     decks = []
     render_case("shear_cell", {**base, "normal_stress": stress, "P": 0.8}, cfg, work_dir / "shear")
     decks.append(BaseDeck("shear_cell", work_dir / "shear", DECK_NAMES["shear_cell"]))
+    ring = load_config(config)
+    ring["shear_cell"].update(geometry="ring", dCylDp=24, fill_height=0.5, overfill=0.15)
+    render_case("shear_cell", {**base, "normal_stress": stress, "P": 0.8}, ring, work_dir / "ring")
+    decks.append(BaseDeck("ring_shear_cell", work_dir / "ring", DECK_NAMES["shear_cell"]))
     render_case("angle_of_repose", base, load_config(config), work_dir / "aor")
     decks.append(BaseDeck("angle_of_repose", work_dir / "aor", DECK_NAMES["angle_of_repose"]))
     render_chute_cooler(load_config(config), work_dir / "chute")

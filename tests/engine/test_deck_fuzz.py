@@ -68,7 +68,12 @@ def test_mutations_are_seeded_and_runs_capped(tmp_path: Path) -> None:
     again = make_cases(bases, 12, 3, max_steps=7)
     assert [c.text for c in first] == [c.text for c in again]
     assert [c.text for c in make_cases(bases, 12, 4, 7)] != [c.text for c in first]
-    assert {c.base for c in first} == {"shear_cell", "angle_of_repose", "chute_cooler"}
+    assert {c.base for c in first} == {
+        "shear_cell",
+        "ring_shear_cell",
+        "angle_of_repose",
+        "chute_cooler",
+    }
     for case in first:
         assert 1 <= len(case.mutations) <= 3
         for line in case.text.splitlines():

@@ -371,6 +371,8 @@ def test_ring_geometry_force_and_rotation() -> None:
         else:
             assert (period, sign) == (0.0, 0)
     assert s.settle_steps == s.fill_steps - 1
+    # Particles are inserted clear of the floor bars (they overlapped them at step 1 before).
+    assert s.insertion_zlo == pytest.approx(2e-3 + 1.05e-3)
 
 
 def test_split_cell_has_no_ring_fields() -> None:

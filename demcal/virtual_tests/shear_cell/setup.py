@@ -344,7 +344,8 @@ def shear_cell_setup(
             f"dCylDp = {dCylDp:g} leaves no room to insert particles of radius {r_max:g} m"
         )
     solid = n_particles * dist.mean_particle_volume
-    ins_zlo = 1.05 * r_max
+    # Inserted particles clear the floor and, in the ring, its bars.
+    ins_zlo = 1.05 * r_max + (ring.bar_height if ring is not None else 0.0)
     ins_zhi = ins_zlo + solid / (phi_ins * math.pi * ins_radius**2)
     wall_top = ins_zhi + 2.0 * r_max
     if ring is not None:
