@@ -189,6 +189,11 @@ def _apply(settings: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[st
     return cfg
 
 
+def _text(value: Any) -> str:
+    """A level value in a directory name: numbers in the shortest form, words as they are."""
+    return f"{value:g}" if isinstance(value, int | float) else str(value)
+
+
 def _base_value(settings: Mapping[str, Any], key: str) -> Any:
     section, name = key.split(".", 1)
     return settings.get(section, {}).get(name)
@@ -247,7 +252,7 @@ def plan_study(
             # Overrides equal to the base configuration change nothing: the base run is
             # shared by every factor that passes through it.
             changed = {k: v for k, v in overrides.items() if _base_value(settings, k) != v}
-            key = "__".join(f"{k}={v:g}" for k, v in sorted(changed.items())) or "base"
+            key = "__".join(f"{k}={_text(v)}" for k, v in sorted(changed.items())) or "base"
             cfg = _apply(settings, overrides)
             for set_name, params in sets.items():
                 case: dict[str, Any] = {"case_id": set_name, **params}

@@ -111,3 +111,24 @@ def test_summary_measures_distance_to_the_most_refined_level() -> None:
     assert aor.loc[1.0, "deviation"] == pytest.approx(2.5)
     assert aor["converged"].tolist() == [False, True, True, True]
     assert np.isnan(aor.loc[1.0, "sd"])
+
+
+def test_ring_width_levels_keep_height_and_travel_in_particle_sizes(tmp_path: Path) -> None:
+    settings = load_config(ROOT / "config" / "tiny.yaml")
+    factor = FACTORS["ring_dCylDp"]
+    planned = plan_study(
+        settings, {"a": SET}, [factor], [1], tmp_path, "dem_engine -in {x}", 2029.0
+    )
+    assert len(planned) == len(factor.levels) == 4
+    for job, _, overrides in planned:
+        setup = json.loads((job.case_dir / "case.json").read_text())["setup"]
+        r = setup["reference_radius"]
+        assert setup["geometry"] == "ring"
+        assert setup["radius"] == pytest.approx(overrides["shear_cell.dCylDp"] * r)
+        assert setup["radius"] - setup["inner_radius"] == pytest.approx(setup["radius"] / 2)
+        # Six diameters of bed and nine of pre-shear travel at every width.
+        assert setup["fill_height"] == pytest.approx(12.0 * r)
+        travel = setup["shear_speed"] * setup["preshear_time"]
+        assert travel == pytest.approx(18.0 * r)
+    # The level's words and numbers name its directory.
+    assert "shear_cell.geometry=ring" in str(planned[0][0].case_dir)
