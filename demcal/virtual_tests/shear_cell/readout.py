@@ -112,6 +112,11 @@ RING_COLUMNS: tuple[str, ...] = (
 _SOURCE = "shear-cell table"
 
 
+def _cross_section(radius: float, inner_radius: float | None) -> float:
+    """Cell cross-section pi (R^2 - R_i^2), m^2 (R_i None or 0: the split cell's disc)."""
+    return float(np.pi * (radius**2 - (inner_radius or 0.0) ** 2))
+
+
 def required_columns(inner_radius: float | None = None) -> tuple[str, ...]:
     """Print-file columns the readout needs: the split cell's, or the ring's when
     ``inner_radius`` (m) is given and positive."""
@@ -237,7 +242,7 @@ def shear_stress_series(
     ring = bool(inner_radius)
     column = {name: out[name].to_numpy(dtype=np.float64) for name in required_columns(inner_radius)}
     r_in = float(inner_radius) if ring else 0.0
-    cross_section = np.pi * (radius**2 - r_in**2)
+    cross_section = _cross_section(radius, inner_radius)
     lid_z = column["lid_z"]
     if ring:
         area = np.full(len(out), cross_section)
@@ -324,7 +329,7 @@ def shear_cell_bulk_values(
         pre-shear target force, or time running backwards within a phase.
     """
     series = shear_stress_series(table, radius, z_floor, z_shear, g, inner_radius)
-    cross_section = np.pi * (radius**2 - (inner_radius or 0.0) ** 2)
+    cross_section = _cross_section(radius, inner_radius)
     records = []
     phase = series["phase"].to_numpy()
     cycles = np.unique(series["cycle"].to_numpy()[np.isin(phase, [PHASE_PRE_SHEAR, PHASE_SHEAR])])

@@ -319,7 +319,9 @@ def shear_cell_setup(
     r_ref = dist.mass_mean_radius
     r_max = dist.max_radius
     radius = float(dCylDp) * r_ref
-    ring = _ring_geometry(cell, radius, r_ref, r_max) if geometry == "ring" else None
+    is_ring = geometry == "ring"
+    # The split cell has no inner wall and no bars: all ring lengths are zero.
+    ring = _ring_geometry(cell, radius, r_ref, r_max) if is_ring else _NO_RING
     n_seg = int(_get(cell, "n_segments", where))
     if n_seg < 12:
         raise SetupError(f"configuration: 'shear_cell.n_segments' must be >= 12, got {n_seg}")
@@ -345,14 +347,14 @@ def shear_cell_setup(
         )
     solid = n_particles * dist.mean_particle_volume
     # Inserted particles clear the floor and, in the ring, its bars.
-    ins_zlo = 1.05 * r_max + (ring.bar_height if ring is not None else 0.0)
+    ins_zlo = 1.05 * r_max + ring.bar_height
     ins_zhi = ins_zlo + solid / (phi_ins * math.pi * ins_radius**2)
     wall_top = ins_zhi + 2.0 * r_max
-    if ring is not None:
+    if is_ring:
         # The lid starts above the scraped bed with its bars clear of the particles.
         wall_top = max(wall_top, fill_height + ring.bar_height + 3.05 * r_max)
     z_shear = shear_plane * fill_height
-    if ring is not None:
+    if is_ring:
         clear = ring.bar_height + 2.0 * r_max
         if min(z_shear, fill_height - z_shear) < clear:
             raise SetupError(
@@ -386,8 +388,7 @@ def shear_cell_setup(
     if min(kp, ki, kd) < 0.0 or kp + ki + kd <= 0.0:
         raise SetupError("configuration: servo_kp, servo_ki, servo_kd must be >= 0, not all 0")
 
-    inner = ring.inner_radius if ring is not None else 0.0
-    force = normal_stress * math.pi * (radius**2 - inner**2)
+    force = normal_stress * math.pi * (radius**2 - ring.inner_radius**2)
     p_values = _p_values(_get(cell, "P", where))
 
     # Free fall from the top of the insertion region, then settling.
@@ -420,7 +421,7 @@ def shear_cell_setup(
     cycles = schedule.cycles
     max_offset = schedule.max_offset
     margin = 4.0 * r_max
-    if ring is None:
+    if not is_ring:
         flange = max_offset + 4.0 * r_max
         half_x = radius + flange + max_offset + margin
         half_y = radius + flange + margin
@@ -467,7 +468,7 @@ def shear_cell_setup(
         insertion_zhi=ins_zhi,
         box_lo=box_lo,
         box_hi=box_hi,
-        lid_gap=1.05 * r_max + (ring.bar_height if ring is not None else 0.0),
+        lid_gap=1.05 * r_max + ring.bar_height,
         normal_stress=float(normal_stress),
         preshear_force=force,
         lid_target_val=-force,
@@ -492,11 +493,11 @@ def shear_cell_setup(
         contact_dump_every=max(1, n_psh // snapshots) if snapshots else 0,
         seeds=insertion_seeds(seed, dist.n_classes),
         geometry=geometry,
-        inner_radius=inner,
-        core_radius=ring.core_radius if ring is not None else 0.0,
-        mean_radius=ring.mean_radius if ring is not None else 0.0,
-        n_bars=ring.n_bars if ring is not None else 0,
-        bar_height=ring.bar_height if ring is not None else 0.0,
+        inner_radius=ring.inner_radius,
+        core_radius=ring.core_radius,
+        mean_radius=ring.mean_radius,
+        n_bars=ring.n_bars,
+        bar_height=ring.bar_height,
         rotation=rotation,
     )
 
@@ -508,6 +509,9 @@ class _Ring:
     mean_radius: float
     n_bars: int
     bar_height: float
+
+
+_NO_RING = _Ring(inner_radius=0.0, core_radius=0.0, mean_radius=0.0, n_bars=0, bar_height=0.0)
 
 
 def _ring_geometry(cell: Mapping[str, Any], radius: float, r_ref: float, r_max: float) -> _Ring:
