@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any
 
 from demcal.core import config_values
@@ -493,11 +493,8 @@ def shear_cell_setup(
         contact_dump_every=max(1, n_psh // snapshots) if snapshots else 0,
         seeds=insertion_seeds(seed, dist.n_classes),
         geometry=geometry,
-        inner_radius=ring.inner_radius,
-        core_radius=ring.core_radius,
-        mean_radius=ring.mean_radius,
-        n_bars=ring.n_bars,
-        bar_height=ring.bar_height,
+        # The ring record's fields are the set-up's ring fields.
+        **asdict(ring),
         rotation=rotation,
     )
 
