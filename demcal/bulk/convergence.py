@@ -87,16 +87,24 @@ def _levels(key: str, values: Sequence[float], **fixed: Any) -> tuple[dict[str, 
 
 #: The factors of the study, each ordered cheapest first. The stiffness levels lift the cap on
 #: the shear cell's modulus so that Y / sigma is what varies. Coarse-graining keeps the cell's
-#: physical size (dCylDp x scale = 24 for the shear cell, 18 for the heap) and changes only how
-#: many particles fill it.
+#: physical size (dCylDp x scale = 48 for the shear cell, the quick ring; 18 for the heap) and
+#: changes only how many particles fill it.
 FACTORS: dict[str, Factor] = {
     f.name: f
     for f in (
         Factor(
             "shear_dCylDp",
             "shear_cell",
-            "cell diameter / particle diameter dCylDp",
-            _levels("shear_cell.dCylDp", (8, 12, 18, 24)),
+            "split cell: diameter / particle diameter dCylDp",
+            # The split cell as the quick profile ran it before the ring.
+            _levels(
+                "shear_cell.dCylDp",
+                (8, 12, 18, 24),
+                shear_cell__geometry="split",
+                shear_cell__fill_height=1.5,
+                shear_cell__overfill=0.3,
+                shear_cell__preshear_travel=0.375,
+            ),
             "shear_cell.dCylDp",
         ),
         Factor(
@@ -128,7 +136,7 @@ FACTORS: dict[str, Factor] = {
             "shear_coarse_graining",
             "shear_cell",
             "coarse-graining factor (particle radii x)",
-            tuple({"particles.scale": s, "shear_cell.dCylDp": 24.0 / s} for s in (3.0, 2.0, 1.5)),
+            tuple({"particles.scale": s, "shear_cell.dCylDp": 48.0 / s} for s in (3.0, 2.0, 1.5)),
             "particles.scale",
         ),
         Factor(

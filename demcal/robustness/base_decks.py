@@ -11,6 +11,32 @@ from demcal.core.config import load_config
 from demcal.robustness.mutation import BaseDeck
 from demcal.virtual_tests.deck import DECK_NAMES, render_case
 
+#: The shear-cell keys that make the quick profile's ring cell (its geometry and size in mean
+#: radii); with the tiny particles the ring is the same number of particles wide.
+RING_KEYS = ("geometry", "dCylDp", "fill_height", "overfill")
+
+
+def with_quick_ring(config: Path, keys: tuple[str, ...] = RING_KEYS) -> dict:
+    """A validated configuration whose shear cell is the ring of ``config/config.yaml``.
+
+    Parameters
+    ----------
+    config : Path
+        Configuration file (the tiny profile in the tests and the fuzzer).
+    keys : tuple of str
+        Shear-cell keys taken from the quick profile.
+
+    Returns
+    -------
+    dict
+        ``config`` validated, with ``keys`` of the quick profile's shear cell.
+    """
+    root = Path(__file__).resolve().parents[2]
+    quick = load_config(root / "config" / "config.yaml")["shear_cell"]
+    cfg = load_config(config)
+    cfg["shear_cell"].update({key: quick[key] for key in keys})
+    return cfg
+
 
 def render_base_decks(work_dir: Path, config: Path | None = None) -> list[BaseDeck]:
     """Render the tiny shear cells, angle of repose and chute cooler decks into ``work_dir``.
@@ -42,8 +68,7 @@ def render_base_decks(work_dir: Path, config: Path | None = None) -> list[BaseDe
     decks = []
     render_case("shear_cell", {**base, "normal_stress": stress, "P": 0.8}, cfg, work_dir / "shear")
     decks.append(BaseDeck("shear_cell", work_dir / "shear", DECK_NAMES["shear_cell"]))
-    ring = load_config(config)
-    ring["shear_cell"].update(geometry="ring", dCylDp=24, fill_height=0.5, overfill=0.15)
+    ring = with_quick_ring(config)
     render_case("shear_cell", {**base, "normal_stress": stress, "P": 0.8}, ring, work_dir / "ring")
     decks.append(BaseDeck("ring_shear_cell", work_dir / "ring", DECK_NAMES["shear_cell"]))
     render_case("angle_of_repose", base, load_config(config), work_dir / "aor")

@@ -26,6 +26,7 @@ import pytest
 from demcal.bulk.values import extract
 from demcal.core.config import load_config
 from demcal.engine_io.fix_output import read_print_file
+from demcal.robustness.base_decks import RING_KEYS, with_quick_ring
 from demcal.virtual_tests.deck import DECK_NAMES, render_case
 from tests.engine.conftest import engine_path
 from tests.figures import bbox, colour_mask, distinct_colours, ink, read_png
@@ -43,16 +44,9 @@ BASE = {
 AOR_BASE = {**BASE, "coefficientRollingFriction": 0.2}
 SEEDS = (7, 11, 12, 13)
 P_TRENDS = 0.8  # P < 1 for the shear-phase comparison
-# The ring shear cell, 6 particle diameters wide, with 9 diameters of pre-shear travel (the
-# scraped high-friction beds compact for 4-5), and its parameter sets: low and high sliding
-# friction, and strong interlocking (particles pinch at the rim of the split cell).
-RING = {
-    "geometry": "ring",
-    "dCylDp": 24,
-    "fill_height": 0.5,
-    "overfill": 0.15,
-    "preshear_travel": 0.75,
-}
+# The quick profile's ring shear cell (6 particle diameters wide, 9 diameters of pre-shear
+# travel: the scraped high-friction beds compact for 4-5), and its parameter sets: low and
+# high sliding friction, and strong interlocking (particles pinch at the rim of the split cell).
 RING_SETS = {
     "low": {"coefficientFriction": 0.1},
     "high": {"coefficientFriction": 0.8},
@@ -120,7 +114,8 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         dirs[name] = root / name
         cfg = _settings(seed)
         if name.startswith("ring_"):
-            cfg["shear_cell"].update(RING)
+            cfg = with_quick_ring(ROOT / "config" / "tiny.yaml", (*RING_KEYS, "preshear_travel"))
+            cfg["seed"] = seed
         render_case(test, {"case_id": "c0001", **case}, cfg, dirs[name])
     # Longest runs first, so that two engine processes stay busy to the end.
     order = sorted(cases, key=lambda n: (cases[n][0] != "angle_of_repose", n != "cycles"))

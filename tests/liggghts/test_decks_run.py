@@ -33,6 +33,7 @@ from demcal.bulk.values import extract
 from demcal.core.config import load_config
 from demcal.engine_io.fix_output import read_print_file
 from demcal.engine_io.vtk_file import read_vtk_particles
+from demcal.robustness.base_decks import with_quick_ring
 from demcal.virtual_tests.deck import DECK_NAMES, render_case
 from demcal.virtual_tests.shear_cell.plane_stress import plane_stress_series
 
@@ -157,8 +158,8 @@ def test_ring_shear_cell_deck_runs_on_two_mpi_ranks(tmp_path: Path) -> None:
     # The ring cell (6 particle diameters wide) on two ranks: its turning floor, bars and
     # bands cross the sub-domain boundary. A shorter settling keeps the run short when the two
     # ranks share busy cores.
-    ring = {"geometry": "ring", "dCylDp": 24, "fill_height": 0.5, "overfill": 0.15}
-    cfg = settings({"shear_cell": {**ring, "settle_fall_times": 1.0}})
+    cfg = with_quick_ring(ROOT / "config" / "tiny.yaml")
+    cfg["shear_cell"]["settle_fall_times"] = 1.0
     record = render_case("shear_cell", {**BASE, "normal_stress": STRESS, "P": 0.8}, cfg, tmp_path)
     run = run_liggghts(tmp_path, DECK_NAMES["shear_cell"], ranks=2)
     check_clean_run(run)

@@ -18,6 +18,7 @@ from demcal.decks.case_validation import CaseValidationError, MissingColumnError
 from demcal.decks.render import format_number, template_environment
 from demcal.decks.stl_file import read_stl
 from demcal.decks.triangle_surface import surface_area
+from demcal.robustness.base_decks import with_quick_ring
 from demcal.virtual_tests.deck import render_case
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -441,10 +442,9 @@ def test_validate_config_defaults_cover_the_new_sections() -> None:
 
 
 def ring() -> dict:
-    """The tiny configuration with the ring shear cell (6 particle diameters wide)."""
-    cfg = tiny()
-    cfg["shear_cell"].update(geometry="ring", dCylDp=24, fill_height=0.5, overfill=0.15)
-    return cfg
+    """The tiny configuration with the quick profile's ring shear cell (6 particle diameters
+    wide)."""
+    return with_quick_ring(ROOT / "config" / "tiny.yaml")
 
 
 def test_ring_deck_turns_the_lower_part_and_reads_the_torque(tmp_path: Path) -> None:

@@ -115,7 +115,8 @@ def test_run_suffixes_keep_the_measured_conditions(study):
         MeasuredCondition({"rho_b": 1700.0}, {}, 99.0, 0.5),
     ]
     # Study model: stresses 1068, 2029, 10070 Pa, P = 0.5, one run per condition.
-    assert run_suffixes(study, Experiment("m", "", conds)) == ["_s2_p1"]
+    separate = deep_merge(study, {"shear_cell": {"separate_runs": True}})
+    assert run_suffixes(separate, Experiment("m", "", conds)) == ["_s2_p1"]
     cycles = deep_merge(study, {"shear_cell": {"separate_runs": False}})
     assert run_suffixes(cycles, Experiment("m", "", conds)) == ["_s2"]
 
