@@ -54,8 +54,11 @@ RING_SETS = {
 }
 
 
-def _settings(seed: int = 7) -> dict:
-    cfg = load_config(ROOT / "config" / "tiny.yaml")
+def _settings(seed: int = 7, ring: bool = False) -> dict:
+    """The tiny profile with ``seed``; with ``ring`` its shear cell is the quick profile's ring
+    with its pre-shear travel."""
+    tiny = ROOT / "config" / "tiny.yaml"
+    cfg = with_quick_ring(tiny, (*RING_KEYS, "preshear_travel")) if ring else load_config(tiny)
     cfg["seed"] = seed
     return cfg
 
@@ -112,10 +115,7 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     dirs: dict[str, Path] = {}
     for name, (test, case, seed) in cases.items():
         dirs[name] = root / name
-        cfg = _settings(seed)
-        if name.startswith("ring_"):
-            cfg = with_quick_ring(ROOT / "config" / "tiny.yaml", (*RING_KEYS, "preshear_travel"))
-            cfg["seed"] = seed
+        cfg = _settings(seed, ring=name.startswith("ring_"))
         render_case(test, {"case_id": "c0001", **case}, cfg, dirs[name])
     # Longest runs first, so that two engine processes stay busy to the end.
     order = sorted(cases, key=lambda n: (cases[n][0] != "angle_of_repose", n != "cycles"))

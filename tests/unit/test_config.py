@@ -4,6 +4,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from snakemake.utils import update_config
 
 from demcal.core.config import (
     ConfigError,
@@ -24,6 +25,7 @@ from demcal.core.parameters import (
     out_of_bounds,
 )
 from demcal.design.cases import verification_engines, verification_threads
+from demcal.virtual_tests.deck import DECK_NAMES, render_case
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -306,3 +308,27 @@ def test_parameter_groups_cover_the_table_in_its_order():
         "coefficientRestitution": "COR (-)",
         "density": "rho_p (kg/m^3)",
     }
+
+
+def test_tiny_renders_the_same_decks_alone_and_merged_over_the_quick_profile(tmp_path):
+    # Snakemake merges `--configfile config/tiny.yaml` over config/config.yaml; the scripts and
+    # the discrepancy matrix read tiny.yaml alone. Both must give the same virtual tests, or
+    # data made one way are fitted by a model made the other way.
+    tiny = yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text())
+    merged = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    update_config(merged, yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text()))
+    case = {
+        "case_id": "c0001",
+        "coefficientFriction": 0.5,
+        "coefficientRollingFriction": 0.3,
+        "coefficientRestitution": 0.6,
+        "density": 3000.0,
+        "normal_stress": 2029.0,
+    }
+    for test, row in (("shear_cell", case), ("angle_of_repose", case)):
+        decks = []
+        for name, data in (("alone", tiny), ("merged", merged)):
+            out = tmp_path / name / test
+            render_case(test, row, validate_config(data, name), out)
+            decks.append((out / DECK_NAMES[test]).read_text())
+        assert decks[0] == decks[1], test

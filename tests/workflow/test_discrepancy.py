@@ -73,6 +73,15 @@ def summary(work: Path) -> dict:
     return json.loads((work / "results" / "discrepancy" / "summary.json").read_text())
 
 
+def ranking_record(work: Path) -> dict:
+    return json.loads((work / "results" / "discrepancy" / "ranking.json").read_text())
+
+
+def undecided_pair(record: dict) -> list[str]:
+    """The two candidates the ranking could not tell apart, alphabetically (empty if none)."""
+    return sorted(record.get("ambiguous") or ())
+
+
 @pytest.mark.parametrize("name", list(SCENARIOS))
 def test_all_outputs_written(studies, name):
     out = studies[name] / "results" / "discrepancy"
@@ -102,8 +111,7 @@ def test_all_outputs_written(studies, name):
     # The matrix row of the study agrees with its summary and ranking (an undecided naming is
     # the ambiguous pair, names in alphabetical order).
     row = json.loads((studies[name] / "row.json").read_text())
-    ranking = json.loads((studies[name] / "results" / "discrepancy" / "ranking.json").read_text())
-    pair = sorted(ranking.get("ambiguous") or ())
+    pair = undecided_pair(ranking_record(studies[name]))
     undecided = f"{AMBIGUOUS}: {pair[0]} / {pair[1]}" if pair else NOT_EXPLAINED
     assert row["outcome"] == ((result["winner"] or undecided) if result["missing"] else NOTHING), (
         name
@@ -139,8 +147,8 @@ def test_hidden_effect_is_found_and_named_or_undecided(studies, name):
     result = summary(studies[name])
     assert result["missing"] and result["p_value"] < result["alpha"], result["verdict"]
     out = studies[name] / "results" / "discrepancy"
-    record = json.loads((out / "ranking.json").read_text())
-    named = [result["winner"]] if result["winner"] else sorted(record.get("ambiguous") or ())
+    record = ranking_record(studies[name])
+    named = [result["winner"]] if result["winner"] else undecided_pair(record)
     assert name in named, (named, result["ranking"])
     # The responses were taken against the mean of the three reference runs at theta*.
     assert "minus the mean of 3 at theta*" in (out / "ranking.md").read_text()
