@@ -189,11 +189,23 @@ def parameter_problems(config: Mapping[str, Any]) -> list[str]:
     return problems
 
 
+def _shear_cell_problems(config: Mapping[str, Any]) -> list[str]:
+    """Combinations of ``shear_cell`` keys that the schema cannot express."""
+    cell = config.get("shear_cell", {})
+    if cell.get("cycles") == "continue" and cell.get("geometry") != "ring":
+        # A split cell's lower part would move one cycle's travel further per cycle.
+        return [
+            "shear_cell.cycles: 'continue' needs shear_cell.geometry 'ring', got "
+            f"{cell.get('geometry')!r} (a split cell cannot keep shearing in one direction)"
+        ]
+    return []
+
+
 def validate_config(config: dict, source: str) -> dict:
     """Validate a workflow configuration (``config/*.yaml``) in place and return it.
 
     The schema first (filling defaults), then the contact-parameter names and values
-    (:func:`parameter_problems`).
+    (:func:`parameter_problems`) and the shear-cell keys that only work together.
 
     Raises
     ------
@@ -201,7 +213,7 @@ def validate_config(config: dict, source: str) -> dict:
         Listing every violation with its dotted key path.
     """
     validate(config, "config.schema.yaml", source)
-    problems = parameter_problems(config)
+    problems = parameter_problems(config) + _shear_cell_problems(config)
     if problems:
         lines = "\n  ".join(problems)
         raise ConfigError(f"{source}: invalid configuration:\n  {lines}")

@@ -13,7 +13,7 @@ from demcal.virtual_tests.deck import DECK_NAMES, render_case
 
 #: The shear-cell keys that make the quick profile's ring cell (its geometry and size in mean
 #: radii); with the tiny particles the ring is the same number of particles wide.
-RING_KEYS = ("geometry", "dCylDp", "fill_height", "overfill")
+RING_KEYS = ("geometry", "dCylDp", "fill_height", "overfill", "cycles")
 
 
 def with_quick_ring(config: Path, keys: tuple[str, ...] = RING_KEYS) -> dict:

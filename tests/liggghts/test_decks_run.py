@@ -156,19 +156,25 @@ def check_shear_plane(case_dir: Path, values: pd.Series) -> None:
 
 def test_ring_shear_cell_deck_runs_on_two_mpi_ranks(tmp_path: Path) -> None:
     # The ring cell (6 particle diameters wide) on two ranks: its turning floor, bars and
-    # bands cross the sub-domain boundary. A shorter settling keeps the run short when the two
-    # ranks share busy cores.
+    # bands cross the sub-domain boundary. Two cycles in the quick profile's "continue" mode
+    # (the next pre-shear follows the shear in the same direction). A shorter settling keeps
+    # the run short when the two ranks share busy cores.
     cfg = with_quick_ring(ROOT / "config" / "tiny.yaml")
-    cfg["shear_cell"]["settle_fall_times"] = 1.0
-    record = render_case("shear_cell", {**BASE, "normal_stress": STRESS, "P": 0.8}, cfg, tmp_path)
+    assert cfg["shear_cell"]["cycles"] == "continue"
+    cfg["shear_cell"].update(settle_fall_times=1.0, P=TWO_CYCLES)
+    record = render_case("shear_cell", {**BASE, "normal_stress": STRESS}, cfg, tmp_path)
     run = run_liggghts(tmp_path, DECK_NAMES["shear_cell"], ranks=2)
     check_clean_run(run)
     assert re.search(r"(1 by 1 by 2|1 by 2 by 1|2 by 1 by 1) MPI processor grid", run.stdout)
     values = extract("shear_cell", tmp_path)
-    check_shear_values(values, [0.8])
+    check_shear_values(values, TWO_CYCLES)
     # Sheared sphere packings: a macroscopic friction well below 1 (PHYSICS.md); the split
     # cell of the same size reads 1.5 and more at the quick scale.
-    assert 0.3 < values["mu_psh"].iloc[0] < 0.9, values
+    assert values["mu_psh"].between(0.3, 0.9).all(), values
+    # The lower part turned one way through both cycles: the printed travel only falls.
+    travel = read_print_file(tmp_path / "shear_cell.txt", columns=["phase", "travel"])
+    sheared = travel[travel["phase"] >= 1]["travel"].to_numpy()
+    assert np.all(np.diff(sheared) <= 0.0) and sheared[-1] < sheared[0], sheared
     vtk = read_vtk_particles(tmp_path / "shear_preshear_end.vtk", arrays=["radius", "v"])
     # Every particle stays in the annulus (none lost through the turning floor or the bands).
     reach = np.hypot(vtk.points[:, 0], vtk.points[:, 1])

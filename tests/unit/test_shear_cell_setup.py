@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from demcal.core.config import validate_config
+from demcal.core.config import ConfigError, validate_config
 from demcal.core.config_values import SetupError
 from demcal.particles.material import material_setup, rayleigh_time, round_down_sig, time_step
 from demcal.particles.run_setup import prime_seed, steps_for
@@ -373,6 +373,37 @@ def test_ring_geometry_force_and_rotation() -> None:
     assert s.settle_steps == s.fill_steps - 1
     # Particles are inserted clear of the floor bars (they overlapped them at step 1 before).
     assert s.insertion_zlo == pytest.approx(2e-3 + 1.05e-3)
+
+
+def test_continue_mode_shears_on_in_one_direction_without_return() -> None:
+    s, _, _ = setup_for(dCylDp=24.0, cycles="continue", **RING)
+    r, _, _ = setup_for(dCylDp=24.0, cycles="return", **RING)
+    assert [c.direction for c in s.cycles] == [-1, -1, -1, -1]
+    # Compression once, then pre-shear / unload / shear per cycle, nothing in between.
+    assert [g.phase for g in s.segments] == [0] + [1, 2, 3] * 4
+    for a, b in itertools.pairwise(s.cycles):
+        assert b.preshear_start_step == a.shear_end_step
+        assert b.offset_preshear_start == pytest.approx(a.offset_shear_end, abs=1e-12)
+    assert all(g.velocity <= 0.0 for g in s.segments)
+    assert all(p > 0.0 and sign == -1 for p, sign in s.rotation if p)
+    # The same cycles as the return mode, without its three unload / return / compress blocks.
+    saved = sum(g.steps for g in r.segments if g.phase == 0 and g.cycle > 0)
+    assert r.total_steps - s.total_steps == saved
+    for a, b in zip(s.cycles, r.cycles, strict=True):
+        assert (
+            a.preshear_end_step - a.preshear_start_step
+            == b.preshear_end_step - b.preshear_start_step
+        )
+        assert a.shear_end_step - a.shear_start_step == b.shear_end_step - b.shear_start_step
+
+
+def test_continue_mode_needs_the_ring() -> None:
+    with pytest.raises(SetupError, match=r"shear_cell\.cycles.*continue.*ring"):
+        setup_for(cycles="continue")
+    with pytest.raises(ConfigError, match=r"shear_cell\.cycles: 'continue' needs"):
+        validate_config({"shear_cell": {"cycles": "continue", "geometry": "split"}}, "t")
+    cfg = validate_config({"shear_cell": {"cycles": "continue", "geometry": "ring"}}, "t")
+    assert cfg["shear_cell"]["cycles"] == "continue"
 
 
 def test_split_cell_has_no_ring_fields() -> None:

@@ -3,11 +3,13 @@
 Phase 0: settle, scrape, compress with the servo lid to the pre-shear load. Then one cycle per
 value of P: pre-shear at the full load (phase 1), unload the lid to ``unload_force_fraction`` of
 that load with the lower part at rest (phase 2), shear at ``P`` times the pre-shear load
-(phase 3). Several cycles follow each other in one of two ways (``shear_cell.cycles``):
+(phase 3). Several cycles follow each other in one of three ways (``shear_cell.cycles``):
 "return" (every cycle starts at zero offset; in between the lower part returns with the lid
-unloaded and the sample is compressed again) or "alternate" (the direction alternates, the
-offset swings between +h and -h). Steps are counted from the start of the run; offsets are the
-x displacement of the lower part against the upper ring, m.
+unloaded and the sample is compressed again), "alternate" (the direction alternates, the
+offset swings between +h and -h) or "continue" (ring cell only: the next pre-shear follows the
+shear in the same direction, as in a Schulze ring shear tester). Steps are counted from the
+start of the run; offsets are the x displacement of the lower part against the upper ring
+(the ring: travel along the mean circle), m.
 """
 
 from __future__ import annotations
@@ -218,10 +220,15 @@ def schulze_schedule(
       unloaded to ``unload_fraction`` of the pre-shear force, the lower part returns to zero
       offset at ``return_speed``, and the lid compresses the sample again (phase 0 of the next
       cycle). Every cycle then starts like a fresh test.
+    * ``"continue"``: every cycle moves towards -x and the pre-shear of cycle k + 1 follows the
+      shear of cycle k at once (the servo reloads the lid while the lower part turns on), as
+      a Schulze ring shear tester runs its sequence. Only a ring can do this: its lower part
+      turns in place, while the offset of a split cell would grow by one cycle's travel per
+      cycle. No reversal, no return: later cycles meet the fabric the earlier ones built.
 
     Parameters
     ----------
-    mode : {"alternate", "return"}
+    mode : {"alternate", "return", "continue"}
         How cycles follow each other.
     p_values : sequence of float
         Shear loads as fractions of the pre-shear load, one cycle each, -.
@@ -254,7 +261,7 @@ def schulze_schedule(
         line.add("phase 0: move the lower part to +h under load", 0, 0, force, n_pos, speed, dt)
     cycles = []
     for k, p in enumerate(p_values):
-        direction = -1 if (mode == "return" or k % 2 == 0) else 1
+        direction = 1 if (mode == "alternate" and k % 2 == 1) else -1
         towards = "-x" if direction < 0 else "+x"
         if mode == "return" and k > 0:
             line.add(f"cycle {k}: unload", 0, k, unload_fraction * force, unload_steps)

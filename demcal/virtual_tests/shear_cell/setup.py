@@ -134,7 +134,7 @@ class ShearCellSetup(RunSetup):
     flange_width : float
         Radial width of the flanges at the shear plane, m.
     cycle_mode : str
-        "alternate" or "return" (see :func:`shear_cell_setup`).
+        "alternate", "return" or "continue" (see :func:`shear_cell_setup`).
     max_offset : float
         Largest misalignment of the lower part against the upper ring, m.
     n_segments : int
@@ -273,8 +273,8 @@ def shear_cell_setup(
 ) -> ShearCellSetup:
     """Derived quantities of one shear-cell case.
 
-    Several cycles follow each other as ``shear_cell.cycles`` says ("alternate" or "return",
-    see :func:`demcal.virtual_tests.shear_cell.schedule.schulze_schedule`).
+    Several cycles follow each other as ``shear_cell.cycles`` says ("alternate", "return" or
+    "continue", see :func:`demcal.virtual_tests.shear_cell.schedule.schulze_schedule`).
 
     Parameters
     ----------
@@ -307,14 +307,21 @@ def shear_cell_setup(
     if not (math.isfinite(normal_stress) and normal_stress > 0.0):
         raise SetupError(f"normal_stress must be a positive stress (Pa), got {normal_stress!r}")
     mode = _get(cell, "cycles", where)
-    if mode not in ("alternate", "return"):
+    if mode not in ("alternate", "return", "continue"):
         raise SetupError(
-            f"configuration: 'shear_cell.cycles' must be 'alternate' or 'return', got {mode!r}"
+            "configuration: 'shear_cell.cycles' must be 'alternate', 'return' or 'continue', "
+            f"got {mode!r}"
         )
     geometry = _get(cell, "geometry", where)
     if geometry not in ("split", "ring"):
         raise SetupError(
             f"configuration: 'shear_cell.geometry' must be 'split' or 'ring', got {geometry!r}"
+        )
+    if mode == "continue" and geometry != "ring":
+        # The lower part of a split cell would move one cycle's travel further per cycle.
+        raise SetupError(
+            "configuration: 'shear_cell.cycles: continue' needs 'shear_cell.geometry: ring' "
+            "(a split cell cannot keep shearing in one direction)"
         )
     r_ref = dist.mass_mean_radius
     r_max = dist.max_radius
