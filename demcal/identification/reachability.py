@@ -38,6 +38,8 @@ class Reach:
         DEM runs with a finite value at that condition.
     reachable : bool
         ``dem_min (1 - tol) <= measured <= dem_max (1 + tol)``.
+    inside : bool
+        ``dem_min <= measured <= dem_max``: some DEM run of the design lies on either side.
     """
 
     observable: str
@@ -47,6 +49,7 @@ class Reach:
     dem_max: float
     n_runs: int
     reachable: bool
+    inside: bool
 
 
 def _shear_rows(data: pd.DataFrame, stress: float | None, p: float | None) -> pd.DataFrame:
@@ -99,7 +102,10 @@ def reach_of_measurements(data: pd.DataFrame, experiment: Experiment, tol: float
         lo = float(finite.min()) if finite.size else np.nan
         hi = float(finite.max()) if finite.size else np.nan
         reachable = bool(finite.size) and lo * (1.0 - tol) <= measured <= hi * (1.0 + tol)
-        out.append(Reach(name, condition, float(measured), lo, hi, int(finite.size), reachable))
+        inside = bool(finite.size) and lo <= measured <= hi
+        out.append(
+            Reach(name, condition, float(measured), lo, hi, int(finite.size), reachable, inside)
+        )
     return out
 
 
@@ -120,9 +126,25 @@ def reach_statement(reach: list[Reach], material: str) -> str:
     """
     missing = [r for r in reach if not r.reachable]
     if not missing:
+        edge = [r for r in reach if not r.inside]
+        if not edge:
+            return (
+                f"Every measured value of {material} lies within the range the DEM runs of the "
+                "design box cover."
+            )
+        # Within the tolerance of the range but beyond every run: the screening then relies on
+        # the surrogate at the box's edge, where it has the fewest runs around it.
+        parts = [
+            f"{r.observable} ({r.condition}) measured {r.measured:.4g}, "
+            f"{'above' if r.measured > r.dem_max else 'below'} every DEM run of the design box "
+            f"({r.dem_min:.4g} to {r.dem_max:.4g})"
+            for r in edge
+        ]
         return (
-            f"Every measured value of {material} lies within the range the DEM runs of the "
-            "design box cover."
+            f"**The measurement of {material} lies at the edge of what the model reaches**: "
+            + "; ".join(parts)
+            + ". Within the tolerance, but the sets found there rest on the surrogates at the "
+            "edge of the box; check the verification, or widen the box."
         )
     parts = []
     for r in missing:

@@ -36,8 +36,29 @@ def test_a_measurement_inside_the_widened_range_is_reachable(tmp_path: Path) -> 
     # 1760 lies 2.3 % above the largest DEM value at 10 070 Pa, within the 5 % tolerance.
     reach = reach_of_measurements(DATA, experiment(tmp_path, 1760.0, 30.0), tol=0.05)
     assert [r.reachable for r in reach] == [True, True]
+    assert [r.inside for r in reach] == [False, True]
     assert (reach[0].dem_min, reach[0].dem_max, reach[0].n_runs) == (1650.0, 1720.0, 2)
-    assert reach_statement(reach, "test fines").startswith("Every measured value")
+    assert reach_statement(reach, "test fines").startswith(
+        "**The measurement of test fines lies at the edge"
+    )
+    inside = reach_of_measurements(DATA, experiment(tmp_path, 1700.0, 30.0), tol=0.05)
+    assert [r.inside for r in inside] == [True, True]
+    assert reach_statement(inside, "test fines").startswith("Every measured value")
+
+
+def test_a_measurement_beyond_every_run_but_within_the_tolerance_is_at_the_edge(
+    tmp_path: Path,
+) -> None:
+    # The default study's heaps reach 38.0 deg; the sinter fines' 38.85 is 2.2 % above.
+    data = DATA.copy()
+    data.loc[6, "aor"] = 38.0
+    reach = reach_of_measurements(data, experiment(tmp_path, 1700.0, 38.85), tol=0.05)
+    assert [r.reachable for r in reach] == [True, True]
+    assert [r.inside for r in reach] == [True, False]
+    line = reach_statement(reach, "test fines")
+    assert line.startswith("**The measurement of test fines lies at the edge")
+    assert "aor (angle of repose) measured 38.85, above every DEM run" in line
+    assert "(7.8 to 38)" in line and "rho_b" not in line and "\n" not in line
 
 
 def test_the_first_line_names_what_cannot_be_reached(tmp_path: Path) -> None:

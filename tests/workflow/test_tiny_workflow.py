@@ -204,15 +204,17 @@ def test_identification_recovers_synthetic_truth(study):
     experiment = experiment if experiment.is_absolute() else study / experiment
     measured = yaml.safe_load(experiment.read_text())
     data = pd.read_csv(study / "results" / "bulk" / "dataset.csv")
-    reach = []
+    reach, inside = [], []
     for cond in measured["shear_cell"]:
         rows = data[(data["normal_stress"] == cond["normal_stress"]) & (data["P"] == cond["P"])]
         for key in ("mu_psh", "mu_sh", "rho_b"):
             if key in cond:
                 lo, hi = rows[key].min(), rows[key].max()
                 reach.append(0.95 * lo <= cond[key] <= 1.05 * hi)
+                inside.append(lo <= cond[key] <= hi)
     aor = data.loc[data["test"] == "angle_of_repose", "aor"]
     reach.append(0.95 * aor.min() <= measured["angle_of_repose"]["value"] <= 1.05 * aor.max())
+    inside.append(aor.min() <= measured["angle_of_repose"]["value"] <= aor.max())
     first_line = (study / "results" / "identification" / "table5.md").read_text().splitlines()[0]
     assert identified["reachable"] == all(reach), (reach, first_line)
     if not all(reach):
@@ -221,7 +223,12 @@ def test_identification_recovers_synthetic_truth(study):
         # 0.51-0.92). Then no set can be identified, and the report must say so first.
         assert first_line.startswith("**The model cannot reach the measurement"), first_line
         return
-    assert first_line.startswith("Every measured value"), first_line
+    if all(inside):
+        assert first_line.startswith("Every measured value"), first_line
+    else:
+        # Within the tolerance of the runs' range, not inside it: said first, too.
+        assert first_line.startswith("**The measurement of"), first_line
+        assert "lies at the edge of what the model reaches" in first_line, first_line
     assert identified["group"] == "SSC & AoR"
     assert set(identified["parameters"]) == set(truth)
 
