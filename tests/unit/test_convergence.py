@@ -132,3 +132,18 @@ def test_ring_width_levels_keep_height_and_travel_in_particle_sizes(tmp_path: Pa
         assert travel == pytest.approx(18.0 * r)
     # The level's words and numbers name its directory.
     assert "shear_cell.geometry=ring" in str(planned[0][0].case_dir)
+
+
+def test_every_factor_level_renders_on_the_quick_profile(tmp_path: Path) -> None:
+    # The study runs on config/config.yaml; a level that pins the split cell must also pin a
+    # cycle mode the split cell can run (the quick ring continues, a split cell cannot).
+    settings = load_config(ROOT / "config" / "config.yaml")
+    factors = list(FACTORS.values())
+    planned = plan_study(settings, {"a": SET}, factors, [1], tmp_path, "dem_engine -in {x}", 2029.0)
+    assert len(planned) == sum(len(f.levels) for f in factors)
+    for job, _, overrides in planned:
+        record = json.loads((job.case_dir / "case.json").read_text())
+        if record["test"] == "shear_cell":
+            geometry = overrides.get("shear_cell.geometry", "ring")
+            assert record["setup"]["geometry"] == geometry
+            assert record["setup"]["cycle_mode"] == ("continue" if geometry == "ring" else "return")
