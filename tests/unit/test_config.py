@@ -332,3 +332,35 @@ def test_tiny_renders_the_same_decks_alone_and_merged_over_the_quick_profile(tmp
             render_case(test, row, validate_config(data, name), out)
             decks.append((out / DECK_NAMES[test]).read_text())
         assert decks[0] == decks[1], test
+
+
+# Keys a profile may leave to config/config.yaml without effect: tiny's particles are
+# monodisperse (no sieve classes to scale or cut), and the modulus cap binds neither tiny
+# (1000 x 2029 Pa) nor paper (no stress-scaled modulus). Paper's discrepancy candidates are
+# the quick profile's under Snakemake (the paper profile has no discrepancy section).
+WITHOUT_EFFECT = {
+    "tiny": {"particles.scale", "particles.classes", "shear_cell.youngs_modulus_max"},
+    "paper": {"shear_cell.youngs_modulus_max", "discrepancy.candidates"},
+}
+
+
+def _differences(a: object, b: object, path: str = "") -> set[str]:
+    """Dotted keys whose values differ between two nested mappings."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out: set[str] = set()
+        for key in set(a) | set(b):
+            out |= _differences(a.get(key), b.get(key), f"{path}.{key}" if path else key)
+        return out
+    return set() if a == b else {path}
+
+
+@pytest.mark.parametrize("profile", sorted(WITHOUT_EFFECT))
+def test_a_profile_reads_the_same_alone_and_merged_over_the_quick_profile(profile: str) -> None:
+    # Snakemake merges `--configfile config/PROFILE.yaml` over config/config.yaml; scripts
+    # and tests read the profile alone (load_config). Every key with an effect must agree.
+    path = ROOT / "config" / f"{profile}.yaml"
+    alone = validate_config(yaml.safe_load(path.read_text()), "alone")
+    merged = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    update_config(merged, yaml.safe_load(path.read_text()))
+    merged = validate_config(merged, "merged")
+    assert _differences(alone, merged) <= WITHOUT_EFFECT[profile]
