@@ -12,7 +12,9 @@ lid_force             N, normal force of the particles on the lid (positive)
 shear_force           N, horizontal force along the shear direction on the moving lower part
                       (floor and tube) plus that on the fixed upper flange: the force the bulk
                       carries across the shear plane (see below)
-travel                m, displacement of the moving part since the start of the cycle
+travel                m, offset of the moving part against the upper ring (the ring cell:
+                      distance turned along the mean circle, which in the continue mode grows
+                      over all cycles; not used by the ring's readout)
 mass                  kg, particle mass in the cell
 target_force          N, the servo's target lid force in that phase
 upper_force_z         N, vertical force of the particles on the fixed upper tube (positive up)
