@@ -12,7 +12,8 @@ from demcal.robustness.mutation import BaseDeck
 from demcal.virtual_tests.deck import DECK_NAMES, render_case
 
 #: The shear-cell keys that make the quick profile's ring cell (its geometry and size in mean
-#: radii); with the tiny particles the ring is the same number of particles wide.
+#: radii, and its cycle mode); with the tiny particles the ring is the same number of particles
+#: wide.
 RING_KEYS = ("geometry", "dCylDp", "fill_height", "overfill", "cycles")
 
 
