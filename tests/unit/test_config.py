@@ -310,13 +310,21 @@ def test_parameter_groups_cover_the_table_in_its_order():
     }
 
 
+def _alone_and_merged(profile: str) -> tuple[dict, dict]:
+    """config/PROFILE.yaml validated alone (as load_config reads it) and merged over
+    config/config.yaml (as Snakemake reads `--configfile config/PROFILE.yaml`)."""
+    path = ROOT / "config" / f"{profile}.yaml"
+    alone = validate_config(yaml.safe_load(path.read_text()), f"{path} alone")
+    merged = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    update_config(merged, yaml.safe_load(path.read_text()))
+    return alone, validate_config(merged, f"{path} over config/config.yaml")
+
+
 def test_tiny_renders_the_same_decks_alone_and_merged_over_the_quick_profile(tmp_path):
     # Snakemake merges `--configfile config/tiny.yaml` over config/config.yaml; the scripts and
     # the discrepancy matrix read tiny.yaml alone. Both must give the same virtual tests, or
     # data made one way are fitted by a model made the other way.
-    tiny = yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text())
-    merged = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
-    update_config(merged, yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text()))
+    tiny, merged = _alone_and_merged("tiny")
     case = {
         "case_id": "c0001",
         "coefficientFriction": 0.5,
@@ -329,7 +337,7 @@ def test_tiny_renders_the_same_decks_alone_and_merged_over_the_quick_profile(tmp
         decks = []
         for name, data in (("alone", tiny), ("merged", merged)):
             out = tmp_path / name / test
-            render_case(test, row, validate_config(data, name), out)
+            render_case(test, row, data, out)
             decks.append((out / DECK_NAMES[test]).read_text())
         assert decks[0] == decks[1], test
 
@@ -358,9 +366,5 @@ def _differences(a: object, b: object, path: str = "") -> set[str]:
 def test_a_profile_reads_the_same_alone_and_merged_over_the_quick_profile(profile: str) -> None:
     # Snakemake merges `--configfile config/PROFILE.yaml` over config/config.yaml; scripts
     # and tests read the profile alone (load_config). Every key with an effect must agree.
-    path = ROOT / "config" / f"{profile}.yaml"
-    alone = validate_config(yaml.safe_load(path.read_text()), "alone")
-    merged = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
-    update_config(merged, yaml.safe_load(path.read_text()))
-    merged = validate_config(merged, "merged")
+    alone, merged = _alone_and_merged(profile)
     assert _differences(alone, merged) <= WITHOUT_EFFECT[profile]
