@@ -101,6 +101,7 @@ FACTORS: dict[str, Factor] = {
                 "shear_cell.dCylDp",
                 (8, 12, 18, 24),
                 shear_cell__geometry="split",
+                shear_cell__bulk_density="cell",
                 shear_cell__cycles="return",
                 shear_cell__fill_height=1.5,
                 shear_cell__overfill=0.3,
@@ -138,8 +139,16 @@ FACTORS: dict[str, Factor] = {
             "shear_cell",
             "coarse-graining factor (particle radii x)",
             # At x 3 the ring (4 diameters high) leaves no room between its bars and the
-            # shear plane; x 2.5 is the coarsest that renders.
-            tuple({"particles.scale": s, "shear_cell.dCylDp": 48.0 / s} for s in (2.5, 2.0, 1.5)),
+            # shear plane; x 2.5 is the coarsest that renders, and its bed (4.8 diameters)
+            # holds an interior region only half a diameter clear of the bar tips.
+            tuple(
+                {
+                    "particles.scale": s,
+                    "shear_cell.dCylDp": 48.0 / s,
+                    "shear_cell.interior_margin": 0.5,
+                }
+                for s in (2.5, 2.0, 1.5)
+            ),
             "particles.scale",
         ),
         Factor(

@@ -126,7 +126,9 @@ def _shear_cell(case_dir: Path, record: Mapping[str, Any]) -> pd.DataFrame:
     path = _output(case_dir, record, "table")
     # Case records written before the ring cell have no inner radius.
     inner = float(readout.get("inner_radius", 0.0))
-    table = read_print_file(path, columns=[*required_columns(inner), "step"])
+    # Case records written before the interior region measure the whole cell.
+    interior = readout.get("bulk_density", "cell") == "interior"
+    table = read_print_file(path, columns=[*required_columns(inner, interior), "step"])
     _check_complete(table, path, int(setup["total_steps"]), int(setup["print_every"]))
     values = shear_cell_bulk_values(
         table,
@@ -135,6 +137,7 @@ def _shear_cell(case_dir: Path, record: Mapping[str, Any]) -> pd.DataFrame:
         float(readout["z_shear"]),
         float(readout["gravity"]),
         inner_radius=inner,
+        interior_volume=float(readout["interior_volume"]) if interior else None,
         min_fraction=float(readout["min_fraction"]),
     )
     cycles = setup["cycles"]

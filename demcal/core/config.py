@@ -192,12 +192,32 @@ def parameter_problems(config: Mapping[str, Any]) -> list[str]:
 def _shear_cell_problems(config: Mapping[str, Any]) -> list[str]:
     """Combinations of ``shear_cell`` keys that the schema cannot express."""
     cell = config.get("shear_cell", {})
+    problems = []
     if cell.get("cycles") == "continue" and cell.get("geometry") != "ring":
         # A split cell's lower part would move one cycle's travel further per cycle.
-        return [
+        problems.append(
             "shear_cell.cycles: 'continue' needs shear_cell.geometry 'ring', got "
             f"{cell.get('geometry')!r} (a split cell cannot keep shearing in one direction)"
-        ]
+        )
+    if cell.get("bulk_density") == "interior" and cell.get("geometry") != "ring":
+        # The split cell's lower part moves sideways under the bed: no region stays inside.
+        problems.append(
+            "shear_cell.bulk_density: 'interior' needs shear_cell.geometry 'ring', got "
+            f"{cell.get('geometry')!r}"
+        )
+    return problems
+
+
+def _design_problems(config: Mapping[str, Any]) -> list[str]:
+    """``design`` keys that only work with some kinds of study."""
+    design = config.get("design", {})
+    if not design.get("repose_extra_sets"):
+        return []
+    if design.get("kind") == "factorial":
+        return ["design.repose_extra_sets: needs a random, lhs or sobol design, not factorial"]
+    if config.get("sequential", {}).get("enabled"):
+        # The rounds choose every set for both tests; heap-only sets would be runs outside them.
+        return ["design.repose_extra_sets: must be 0 in a sequential study (sequential.enabled)"]
     return []
 
 
@@ -213,7 +233,7 @@ def validate_config(config: dict, source: str) -> dict:
         Listing every violation with its dotted key path.
     """
     validate(config, "config.schema.yaml", source)
-    problems = parameter_problems(config) + _shear_cell_problems(config)
+    problems = parameter_problems(config) + _shear_cell_problems(config) + _design_problems(config)
     if problems:
         lines = "\n  ".join(problems)
         raise ConfigError(f"{source}: invalid configuration:\n  {lines}")

@@ -15,7 +15,8 @@ import pandas as pd
 
 from demcal.core.provenance import write_sidecar
 from demcal.design.build import build_design
-from demcal.design.table import write_design_table
+from demcal.design.table import CASE_ID_COLUMN, write_design_table
+from demcal.design.table import case_ids as numbered_ids
 
 _SHEAR_KEY = re.compile(r"[A-Za-z0-9]+_s(?P<s>\d+)(_p(?P<p>\d+))?")
 
@@ -35,8 +36,30 @@ def design_spec(section: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def design_from_config(config: Mapping[str, Any]) -> pd.DataFrame:
-    """The design table (one row per parameter set) of a validated configuration."""
-    return build_design(design_spec(config["design"]))
+    """The design table (one row per parameter set) of a validated configuration.
+
+    With ``design.repose_extra_sets`` = m > 0, the ``n`` shared sets are followed by m sets of
+    a second design of the same kind and ranges drawn with ``design.seed + 1``, on which only
+    the angle of repose runs (:func:`case_ids`); the ids run on (``c0017 ...`` after 16).
+    """
+    section = config["design"]
+    spec = design_spec(section)
+    table = build_design(spec)
+    extra = repose_extra_sets(config)
+    if not extra:
+        return table
+    more = build_design({**spec, "n": extra, "seed": int(section["seed"]) + 1})
+    both = pd.concat([table, more], ignore_index=True)
+    both[CASE_ID_COLUMN] = numbered_ids(len(both))
+    return both
+
+
+def repose_extra_sets(config: Mapping[str, Any]) -> int:
+    """Sets of the design on which only the angle of repose runs (0 for a factorial design)."""
+    section = config["design"]
+    if section.get("kind") == "factorial":
+        return 0
+    return int(section.get("repose_extra_sets", 0))
 
 
 def write_design(config: Mapping[str, Any], path: str | Path) -> pd.DataFrame:
@@ -66,11 +89,13 @@ def case_ids(config: Mapping[str, Any], design: pd.DataFrame, test: str) -> list
 
     Shear-cell cases run one pre-shear stress (``_s<k>``) and, with
     ``shear_cell.separate_runs``, one shear load P per deck (``_p<j>``); otherwise all P
-    values run as cycles in one deck.
+    values run as cycles in one deck. The last ``design.repose_extra_sets`` rows of the design
+    run only the angle of repose.
     """
     if test == "angle_of_repose":
-        return list(design["case_id"])
-    return [f"{cid}{suffix}" for cid in design["case_id"] for suffix in shear_suffixes(config)]
+        return list(design[CASE_ID_COLUMN])
+    shared = design[CASE_ID_COLUMN].iloc[: len(design) - repose_extra_sets(config)]
+    return [f"{cid}{suffix}" for cid in shared for suffix in shear_suffixes(config)]
 
 
 def shear_suffixes(config: Mapping[str, Any]) -> list[str]:

@@ -53,7 +53,8 @@ NOISE: dict[str, float] = {"mu_psh": 0.03, "mu_sh": 0.03, "rho_b": 0.01, "aor": 
 _MODEL = {
     "particles": {"distribution": "monodisperse"},
     "material": {"rolling_friction": False},
-    "design": {"kind": "lhs"},
+    # The study does not measure the angle of repose: no heap-only sets.
+    "design": {"kind": "lhs", "repose_extra_sets": 0},
 }
 
 _PROFILES: dict[str, dict[str, Any]] = {

@@ -12,9 +12,17 @@ from demcal.robustness.mutation import BaseDeck
 from demcal.virtual_tests.deck import DECK_NAMES, render_case
 
 #: The shear-cell keys that make the quick profile's ring cell (its geometry and size in mean
-#: radii, and its cycle mode); with the tiny particles the ring is the same number of particles
-#: wide.
-RING_KEYS = ("geometry", "dCylDp", "fill_height", "overfill", "cycles")
+#: radii, its cycle mode and where it measures rho_b); with the tiny particles the ring is the
+#: same number of particles wide.
+RING_KEYS = (
+    "geometry",
+    "dCylDp",
+    "fill_height",
+    "overfill",
+    "cycles",
+    "bulk_density",
+    "interior_margin",
+)
 
 
 def with_quick_ring(config: Path, keys: tuple[str, ...] = RING_KEYS) -> dict:

@@ -280,6 +280,8 @@ def render_case(
             "geometry": setup.geometry,
             "radius": setup.radius,
             "inner_radius": setup.inner_radius,
+            "bulk_density": setup.bulk_density,
+            "interior_volume": setup.interior_volume,
             "z_floor": 0.0,
             "z_shear": setup.z_shear,
             "gravity": GRAVITY,

@@ -184,6 +184,23 @@ def test_ring_shear_cell_deck_runs_on_two_mpi_ranks(tmp_path: Path) -> None:
     table = read_print_file(tmp_path / "shear_cell.txt", columns=["phase", "mass"])
     sheared = table[table["phase"] >= 1]["mass"]
     assert sheared.min() == sheared.max()
+    # rho_b of the quick ring is the interior annulus': LIGGGHTS' mass(all,region) at the
+    # printed step next to the snapshot equals the snapshot's particles counted by centre
+    # (a particle or two may cross the region's edge in between), and the interior packs
+    # denser than the whole cell with its looser wall layers.
+    assert setup["bulk_density"] == "interior"
+    rows = read_print_file(tmp_path / "shear_cell.txt", columns=["step", "interior_mass"])
+    near = rows.iloc[int((rows["step"] - setup["snapshot_step"]).abs().argmin())]
+    r, z = np.hypot(vtk.points[:, 0], vtk.points[:, 1]), vtk.points[:, 2]
+    inside = (
+        (r > setup["interior_r_lo"])
+        & (r < setup["interior_r_hi"])
+        & (z > setup["interior_z_lo"])
+        & (z < setup["interior_z_hi"])
+    )
+    counted = DENSITY * 4.0 / 3.0 * math.pi * float(np.sum(vtk.arrays["radius"][inside] ** 3))
+    assert near["interior_mass"] == pytest.approx(counted, rel=0.03), (inside.sum(), near)
+    assert (values["rho_b"] > values["rho_b_cell"]).all(), values
 
 
 def test_angle_of_repose_deck_runs(tmp_path: Path) -> None:

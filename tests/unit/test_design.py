@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.core.config import load_config
+from demcal.core.config import load_config, validate_config
 from demcal.design.build import (
     build_design,
     factorial_design,
@@ -19,6 +19,8 @@ from demcal.design.build import (
     random_design,
     sobol_design,
 )
+from demcal.design.cases import case_ids as study_case_ids
+from demcal.design.cases import design_from_config
 from demcal.design.table import (
     DesignSpecError,
     DesignTableError,
@@ -315,3 +317,37 @@ def test_read_design_table_errors_name_file_and_column(
 def test_read_design_table_missing_file(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError, match=r"nope\.csv"):
         read_design_table(tmp_path / "nope.csv")
+
+
+def test_heap_only_sets_follow_the_shared_sets() -> None:
+    root = Path(__file__).resolve().parents[2]
+    quick = load_config(root / "config" / "config.yaml")
+    n, extra = quick["design"]["n"], quick["design"]["repose_extra_sets"]
+    assert (n, extra) == (16, 48)
+    design = design_from_config(quick)
+    assert design["case_id"].tolist() == case_ids(n + extra)
+    # The shared sets are the design without heap-only sets, unchanged.
+    alone = design_from_config({**quick, "design": {**quick["design"], "repose_extra_sets": 0}})
+    pd.testing.assert_frame_equal(design.iloc[:n], alone)
+    # The heap-only sets are a Latin hypercube of their own (seed + 1) over the same box.
+    heaps = design.iloc[n:]
+    for name, (low, high) in quick["design"]["ranges"].items():
+        column = heaps[name].to_numpy()
+        assert low <= column.min() and column.max() <= high
+        strata = np.floor((column - low) / (high - low) * extra).astype(int)
+        assert sorted(strata.tolist()) == list(range(extra)), name
+    assert study_case_ids(quick, design, "angle_of_repose") == case_ids(n + extra)
+    shear = study_case_ids(quick, design, "shear_cell")
+    assert shear == [f"{c}_s{k}" for c in case_ids(n) for k in (1, 2, 3)]
+    # Heap-only sets need a sampled design, and a sequential study chooses every set itself.
+    for change, key in (
+        (
+            {"design": {"kind": "factorial", "levels": {"coefficientFriction": [0.2, 0.4]}}},
+            "factorial",
+        ),
+        ({"sequential": {"enabled": True}}, "sequential"),
+    ):
+        raw = {"design": {"repose_extra_sets": 4}}
+        raw = {**raw, **change, "design": {**raw["design"], **change.get("design", {})}}
+        with pytest.raises(ValueError, match=rf"design\.repose_extra_sets.*{key}"):
+            validate_config(raw, "t")

@@ -426,3 +426,45 @@ def test_split_cell_has_no_ring_fields() -> None:
 def test_bad_ring_settings_name_the_key(dCylDp: float, cell: dict, match: str) -> None:
     with pytest.raises(SetupError, match=match):
         setup_for(dCylDp=dCylDp, **cell)
+
+
+def test_interior_region_keeps_the_margin_from_walls_and_bar_tips() -> None:
+    # R = 24 mm, R_i = 12 mm, bed 12 mm high, bars 2 mm, margin 1 mean diameter = 2 mm.
+    s, _, _ = setup_for(dCylDp=24.0, bulk_density="interior", interior_margin=1.0, **RING)
+    assert s.bulk_density == "interior"
+    assert (s.interior_r_lo, s.interior_r_hi) == (pytest.approx(0.014), pytest.approx(0.022))
+    # Floor bar tips at 2 mm; the lid's bar tips at the scraped bed height 12 mm minus 2 mm.
+    assert (s.interior_z_lo, s.interior_z_hi) == (pytest.approx(0.004), pytest.approx(0.008))
+    assert s.interior_z_lo < s.z_shear < s.interior_z_hi
+    assert s.interior_volume == pytest.approx(math.pi * (0.022**2 - 0.014**2) * 0.004)
+    assert s.as_dict()["interior_volume"] == pytest.approx(s.interior_volume)
+    wide, _, _ = setup_for(dCylDp=24.0, bulk_density="interior", interior_margin=0.5, **RING)
+    assert wide.interior_volume > s.interior_volume
+
+
+def test_whole_cell_density_has_no_interior_region() -> None:
+    s, _, _ = setup_for(dCylDp=24.0, **RING)
+    assert s.bulk_density == "cell" and s.interior_volume == 0.0
+
+
+def test_interior_density_needs_the_ring_before_any_work() -> None:
+    with pytest.raises(ConfigError, match=r"shear_cell\.bulk_density: 'interior' needs"):
+        validate_config({"shear_cell": {"bulk_density": "interior"}}, "t")
+    cfg = validate_config({"shear_cell": {"bulk_density": "interior", "geometry": "ring"}}, "t")
+    assert cfg["shear_cell"]["interior_margin"] == 1.0
+
+
+@pytest.mark.parametrize(
+    ("cell", "match"),
+    [
+        # the split cell's bed moves against its walls: no fixed interior
+        ({"bulk_density": "interior"}, r"bulk_density: interior' needs .*geometry: ring"),
+        # 3 diameters from the floor bars leave no height below the lid's bars
+        ({**RING, "bulk_density": "interior", "interior_margin": 3.0}, "interior_margin"),
+        ({**RING, "bulk_density": "interior", "interior_margin": -1.0}, "interior_margin"),
+        ({**RING, "bulk_density": "middle"}, "bulk_density"),
+    ],
+)
+def test_bad_interior_settings_name_the_key(cell: dict, match: str) -> None:
+    with pytest.raises(SetupError, match=match):
+        setup_for(dCylDp=24.0, **cell)

@@ -11,6 +11,7 @@ import pytest
 from demcal.engine_io.fix_output import read_print_file
 from demcal.engine_io.output_errors import MissingColumnError
 from demcal.virtual_tests.shear_cell.readout import (
+    INTERIOR_MASS_COLUMN,
     REQUIRED_COLUMNS,
     overlap_area,
     shear_cell_bulk_values,
@@ -366,3 +367,40 @@ def test_ring_readout_needs_the_torque_and_a_valid_inner_radius() -> None:
     # The split cell's columns are not what a ring table holds.
     with pytest.raises(MissingColumnError, match="shear_force"):
         shear_stress_series(table, R, Z_FLOOR, Z_SHEAR, G)
+
+
+def test_ring_interior_density_replaces_the_cells_over_the_same_plateau() -> None:
+    table = ring_table(synthetic_run(CYCLES, seed=4))
+    volume = 2.0e-5  # m^3
+    # The interior packs 12 % denser than the cell and its mass scatters by 1 % row to row.
+    scatter = 1.0 + 0.01 * np.random.default_rng(3).standard_normal(len(table))
+    cell_rho = table["mass"] / (RING_AREA * (table["lid_z"] - Z_FLOOR))
+    table[INTERIOR_MASS_COLUMN] = 1.12 * cell_rho * volume * scatter
+    plain = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G, inner_radius=R_IN)
+    values = shear_cell_bulk_values(
+        table, R, Z_FLOOR, Z_SHEAR, G, inner_radius=R_IN, interior_volume=volume
+    )
+    for spec, row, base in zip(CYCLES, values.itertuples(), plain.itertuples(), strict=True):
+        assert row.rho_b == pytest.approx(1.12 * spec["rho_b"], rel=3e-3)
+        assert row.rho_b_cell == pytest.approx(spec["rho_b"], rel=1e-3)
+        assert base.rho_b == base.rho_b_cell == row.rho_b_cell
+        # The friction values do not depend on where the density is measured.
+        assert (row.mu_psh, row.mu_sh) == (base.mu_psh, base.mu_sh)
+
+
+def test_ring_interior_readout_rejects_a_missing_or_bad_mass_column() -> None:
+    table = ring_table(synthetic_run(CYCLES[:1]))
+    with pytest.raises(MissingColumnError, match=INTERIOR_MASS_COLUMN):
+        shear_cell_bulk_values(
+            table, R, Z_FLOOR, Z_SHEAR, G, inner_radius=R_IN, interior_volume=1e-5
+        )
+    table[INTERIOR_MASS_COLUMN] = 0.01
+    table.loc[7, INTERIOR_MASS_COLUMN] = -1.0
+    with pytest.raises(ValueError, match=rf"{INTERIOR_MASS_COLUMN}.*row 7"):
+        shear_cell_bulk_values(
+            table, R, Z_FLOOR, Z_SHEAR, G, inner_radius=R_IN, interior_volume=1e-5
+        )
+    with pytest.raises(ValueError, match="interior_volume"):
+        shear_cell_bulk_values(
+            table, R, Z_FLOOR, Z_SHEAR, G, inner_radius=R_IN, interior_volume=0.0
+        )

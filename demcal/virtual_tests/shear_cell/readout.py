@@ -53,6 +53,12 @@ the shear stress taken uniform over the plane, gives ``tau = 3 |torque| / (2 pi 
 cycle;
 ``rho_b`` is averaged over the pre-shear plateau. ``P`` is the ratio of the servo target forces
 of shear and pre-shear, and ``normal_stress`` the pre-shear target force over ``pi R^2``.
+
+A ring deck run with ``shear_cell.bulk_density: interior`` also prints ``interior_mass`` (kg),
+the mass of the particles whose centres lie in an annulus clear of the walls and bars; then
+``rho_b`` is that mass over the annulus' volume, averaged over the same plateau, and the whole
+cell's value is kept as ``rho_b_cell``. Counting whole particles by their centres is unbiased
+for a region away from walls, where the packing is the same everywhere on average.
 """
 
 from __future__ import annotations
@@ -67,6 +73,7 @@ from demcal.core.steady_state import Plateau, detect_plateau
 from demcal.engine_io.output_errors import require_columns
 
 __all__ = [
+    "INTERIOR_MASS_COLUMN",
     "PHASE_PRE_SHEAR",
     "PHASE_SETTLE",
     "PHASE_SHEAR",
@@ -111,6 +118,9 @@ RING_COLUMNS: tuple[str, ...] = (
     "upper_force_z",
 )
 
+#: Print-file column of the particle mass in the ring's interior region (kg).
+INTERIOR_MASS_COLUMN = "interior_mass"
+
 _SOURCE = "shear-cell table"
 
 
@@ -119,10 +129,12 @@ def _cross_section(radius: float, inner_radius: float | None) -> float:
     return float(np.pi * (radius**2 - (inner_radius or 0.0) ** 2))
 
 
-def required_columns(inner_radius: float | None = None) -> tuple[str, ...]:
+def required_columns(inner_radius: float | None = None, interior: bool = False) -> tuple[str, ...]:
     """Print-file columns the readout needs: the split cell's, or the ring's when
-    ``inner_radius`` (m) is given and positive."""
-    return RING_COLUMNS if inner_radius else REQUIRED_COLUMNS
+    ``inner_radius`` (m) is given and positive, plus :data:`INTERIOR_MASS_COLUMN` when
+    ``interior``."""
+    columns = RING_COLUMNS if inner_radius else REQUIRED_COLUMNS
+    return (*columns, INTERIOR_MASS_COLUMN) if interior else columns
 
 
 def overlap_area(radius: float, travel: float | np.ndarray) -> float | np.ndarray:
@@ -290,6 +302,7 @@ def shear_cell_bulk_values(
     z_shear: float,
     g: float = GRAVITY,
     inner_radius: float | None = None,
+    interior_volume: float | None = None,
     **plateau_kwargs: Any,
 ) -> pd.DataFrame:
     """Bulk values of every pre-shear/shear cycle of a shear-cell run.
@@ -308,6 +321,9 @@ def shear_cell_bulk_values(
         Gravitational acceleration (m/s^2).
     inner_radius : float, optional
         Inner radius R_i of the ring cell (m); None or 0 for the split cell.
+    interior_volume : float, optional
+        Volume of the interior region whose particle mass the column ``interior_mass``
+        holds (m^3); when given, ``rho_b`` is the interior's and ``rho_b_cell`` the cell's.
     **plateau_kwargs
         Passed on to :func:`demcal.core.steady_state.detect_plateau` (e.g.
         ``min_fraction``).
@@ -317,7 +333,8 @@ def shear_cell_bulk_values(
     pandas.DataFrame
         One row per cycle that has a pre-shear or shear phase, with columns ``cycle``, ``P``
         (-), ``normal_stress`` (Pa), ``mu_psh``, ``mu_sh`` (-), ``rho_b`` (kg/m^3),
-        ``steady_psh``, ``steady_sh`` (bool), the plateau windows ``psh_t_start``,
+        ``rho_b_cell`` (kg/m^3, the whole cell's; equal to ``rho_b`` without an interior
+        region), ``steady_psh``, ``steady_sh`` (bool), the plateau windows ``psh_t_start``,
         ``psh_t_end``, ``sh_t_start``, ``sh_t_end`` (s), the standard errors ``mu_psh_sem``,
         ``mu_sh_sem`` (-) and the detector's ``psh_reason``, ``sh_reason``. Values of a
         missing phase are NaN and its steady flag is False.
@@ -331,6 +348,19 @@ def shear_cell_bulk_values(
         pre-shear target force, or time running backwards within a phase.
     """
     series = shear_stress_series(table, radius, z_floor, z_shear, g, inner_radius)
+    if interior_volume is not None:
+        if not (np.isfinite(interior_volume) and interior_volume > 0.0):
+            raise ValueError(f"interior_volume must be positive, got {interior_volume}")
+        require_columns(list(table.columns), (INTERIOR_MASS_COLUMN,), _SOURCE)
+        mass = pd.to_numeric(series[INTERIOR_MASS_COLUMN], errors="coerce").to_numpy(np.float64)
+        bad = ~(np.isfinite(mass) & (mass >= 0.0))
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise ValueError(
+                f"{_SOURCE}: column {INTERIOR_MASS_COLUMN!r} has a missing, non-numeric or "
+                f"negative value in row {row}"
+            )
+        series["rho_b_interior"] = mass / interior_volume
     cross_section = _cross_section(radius, inner_radius)
     records = []
     phase = series["phase"].to_numpy()
@@ -349,10 +379,13 @@ def shear_cell_bulk_values(
                 f"{_SOURCE}: column 'target_force' must be positive during pre-shear "
                 f"(cycle {int(cycle)}, median {target_pre})"
             )
-        rho_b = np.nan
+        rho_b = rho_b_cell = np.nan
         if p_psh is not None:
             rows = pre.drop_duplicates(subset="time", keep="last")
-            rho_b = float(rows["rho_b"].iloc[p_psh.start_index : p_psh.end_index].mean())
+            plateau = rows.iloc[p_psh.start_index : p_psh.end_index]
+            rho_b = rho_b_cell = float(plateau["rho_b"].mean())
+            if interior_volume is not None:
+                rho_b = float(plateau["rho_b_interior"].mean())
         records.append(
             {
                 "cycle": int(cycle),
@@ -361,6 +394,7 @@ def shear_cell_bulk_values(
                 "mu_psh": p_psh.mean if p_psh else np.nan,
                 "mu_sh": p_sh.mean if p_sh else np.nan,
                 "rho_b": rho_b,
+                "rho_b_cell": rho_b_cell,
                 "steady_psh": bool(p_psh.steady) if p_psh else False,
                 "steady_sh": bool(p_sh.steady) if p_sh else False,
                 "psh_t_start": p_psh.start_time if p_psh else np.nan,
@@ -380,6 +414,7 @@ def shear_cell_bulk_values(
         "mu_psh",
         "mu_sh",
         "rho_b",
+        "rho_b_cell",
         "steady_psh",
         "steady_sh",
         "psh_t_start",

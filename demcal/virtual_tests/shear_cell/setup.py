@@ -190,6 +190,11 @@ class ShearCellSetup(RunSetup):
     rotation : tuple of (float, int)
         Ring: per segment the period of the lower part's rotation (s, 0 at rest) and the sign
         of the rotation axis (+1 anticlockwise seen from above).
+    bulk_density : str
+        "cell" (rho_b of the whole cell) or "interior" (of the ring's interior region).
+    interior_r_lo, interior_r_hi, interior_z_lo, interior_z_hi : float
+        Interior region, an annulus between these radii and heights whose particle mass the
+        deck prints when ``bulk_density`` is "interior" (all 0 otherwise), m.
     """
 
     radius: float
@@ -232,6 +237,11 @@ class ShearCellSetup(RunSetup):
     n_bars: int = 0
     bar_height: float = 0.0
     rotation: tuple[tuple[float, int], ...] = ()
+    bulk_density: str = "cell"
+    interior_r_lo: float = 0.0
+    interior_r_hi: float = 0.0
+    interior_z_lo: float = 0.0
+    interior_z_hi: float = 0.0
 
     @property
     def settle_steps(self) -> int:
@@ -243,10 +253,20 @@ class ShearCellSetup(RunSetup):
         """Cell cross-section pi (R^2 - R_i^2), m^2 (R_i = 0 for the split cell)."""
         return math.pi * (self.radius**2 - self.inner_radius**2)
 
+    @property
+    def interior_volume(self) -> float:
+        """Volume of the interior region, m^3 (0 without one)."""
+        return (
+            math.pi
+            * (self.interior_r_hi**2 - self.interior_r_lo**2)
+            * (self.interior_z_hi - self.interior_z_lo)
+        )
+
     def as_dict(self) -> dict[str, Any]:
         """Plain JSON-ready dict (segments and cycles as lists of dicts)."""
         out = super().as_dict()
         out["cross_section"] = self.cross_section
+        out["interior_volume"] = self.interior_volume
         for seg in out["segments"]:
             seg["ctrl"] = list(seg["ctrl"])
         return out
@@ -457,6 +477,7 @@ def shear_cell_setup(
             f"configuration: 'shear_cell.contact_snapshots' must be >= 0, got {snapshots}"
         )
     smallest_stress = normal_stress * min(p_values)
+    interior = _interior_region(cell, radius, fill_height, z_shear, r_ref, r_max, ring)
     return ShearCellSetup(
         radius=radius,
         reference_radius=r_ref,
@@ -503,6 +524,7 @@ def shear_cell_setup(
         # The ring record's fields are the set-up's ring fields.
         **asdict(ring),
         rotation=rotation,
+        **asdict(interior),
     )
 
 
@@ -516,6 +538,70 @@ class _Ring:
 
 
 _NO_RING = _Ring(inner_radius=0.0, core_radius=0.0, mean_radius=0.0, n_bars=0, bar_height=0.0)
+
+
+@dataclass(frozen=True)
+class _Interior:
+    bulk_density: str
+    interior_r_lo: float
+    interior_r_hi: float
+    interior_z_lo: float
+    interior_z_hi: float
+
+
+def _interior_region(
+    cell: Mapping[str, Any],
+    radius: float,
+    fill_height: float,
+    z_shear: float,
+    r_ref: float,
+    r_max: float,
+    ring: _Ring,
+) -> _Interior:
+    """Where rho_b is measured: the whole cell, or the ring's interior (lengths in m).
+
+    The interior annulus keeps ``interior_margin`` mean diameters from both walls, from the
+    floor bars' tips and from the lid bars' tips, which hang from a lid that rests on the bed
+    scraped at the fill height.
+    """
+    where = "shear_cell"
+    mode = _get(cell, "bulk_density", where)
+    if mode not in ("cell", "interior"):
+        raise SetupError(
+            f"configuration: '{where}.bulk_density' must be 'cell' or 'interior', got {mode!r}"
+        )
+    if mode == "cell":
+        return _Interior("cell", 0.0, 0.0, 0.0, 0.0)
+    if not ring.inner_radius:
+        raise SetupError(
+            f"configuration: '{where}.bulk_density: interior' needs '{where}.geometry: ring' "
+            "(the split cell's bed moves against its walls)"
+        )
+    margin = (
+        _positive(_get(cell, "interior_margin", where), f"{where}.interior_margin") * 2.0 * r_ref
+    )
+    region = _Interior(
+        "interior",
+        interior_r_lo=ring.inner_radius + margin,
+        interior_r_hi=radius - margin,
+        interior_z_lo=ring.bar_height + margin,
+        interior_z_hi=fill_height - ring.bar_height - margin,
+    )
+    # The region must hold at least one largest particle across and up, and straddle the
+    # shear plane, where the pre-shear takes place.
+    width = region.interior_r_hi - region.interior_r_lo
+    height = region.interior_z_hi - region.interior_z_lo
+    if min(width, height) < 2.0 * r_max or not (
+        region.interior_z_lo < z_shear < region.interior_z_hi
+    ):
+        raise SetupError(
+            f"configuration: '{where}.interior_margin' leaves an interior region "
+            f"{width:.4g} m wide and {height:.4g} m high (z {region.interior_z_lo:.4g} to "
+            f"{region.interior_z_hi:.4g} m, shear plane at {z_shear:.4g} m): it must be at "
+            f"least one largest particle diameter ({2.0 * r_max:.4g} m) each way and contain "
+            "the shear plane; lower the margin or widen the ring"
+        )
+    return region
 
 
 def _ring_geometry(cell: Mapping[str, Any], radius: float, r_ref: float, r_max: float) -> _Ring:
