@@ -147,6 +147,7 @@ def _shear_cell(case_dir: Path, record: Mapping[str, Any]) -> pd.DataFrame:
             f"{path}: expected cycles 0..{len(cycles) - 1}, found {found or 'none'}"
         )
     values = values.sort_values("cycle").reset_index(drop=True)
+    values = _preshear_point(values)
     # The load condition as specified, not as re-derived from printed forces.
     values["P"] = [float(c["P"]) for c in cycles]
     values["normal_stress"] = float(setup["normal_stress"])
@@ -155,6 +156,26 @@ def _shear_cell(case_dir: Path, record: Mapping[str, Any]) -> pd.DataFrame:
     values["status"] = "ok"
     rest = [c for c in values.columns if c not in SHEAR_COLUMNS]
     return values[[*SHEAR_COLUMNS, *rest]]
+
+
+def _preshear_point(values: pd.DataFrame) -> pd.DataFrame:
+    """The pre-shear point of a deck's yield locus: mu_psh and rho_b as the means over the
+    pre-shears of all its cycles.
+
+    Every cycle pre-shears at the same normal stress to the same steady state, so its readings
+    are repeated measurements of one point (a ring tester reports their mean), and their mean
+    scatters half as much over four cycles. Each cycle's own reading stays in
+    ``mu_psh_cycle`` and ``rho_b_cycle``; a cycle without a steady pre-shear plateau (NaN)
+    does not count.
+    """
+    out = values.copy()
+    for key in ("mu_psh", "rho_b"):
+        readings = out[key].to_numpy(dtype=np.float64)
+        out[f"{key}_cycle"] = readings
+        finite = readings[np.isfinite(readings)]
+        if len(out) > 1 and finite.size:
+            out[key] = float(finite.mean())
+    return out
 
 
 def _repose(case_dir: Path, record: Mapping[str, Any]) -> pd.DataFrame:
@@ -220,7 +241,8 @@ def extract(test: str, case_dir: Path) -> pd.DataFrame:
     Returns
     -------
     pandas.DataFrame
-        Shear cell: one row per load condition, columns :data:`SHEAR_COLUMNS` then
+        Shear cell: one row per load condition (mu_psh and rho_b are the deck's pre-shear
+        point, the mean over its cycles), columns :data:`SHEAR_COLUMNS` then
         diagnostics. Angle of repose: one row, columns :data:`REPOSE_COLUMNS` then
         ``aor_sector_0 ...`` (degrees).
 

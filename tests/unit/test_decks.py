@@ -323,8 +323,11 @@ def test_paper_profile_has_table_1_values() -> None:
 # bulk values of a rendered case from synthetic outputs with a known truth
 
 
-def write_shear_table(directory: Path, mu_psh: float, mu_sh: float, rho_b: float) -> None:
-    """Print file of a steady run: mu = mu_psh in pre-shear and mu_sh in shear."""
+def write_shear_table(
+    directory: Path, mu_psh: float | list[float], mu_sh: float, rho_b: float
+) -> None:
+    """Print file of a steady run: mu = mu_psh in pre-shear (a value per cycle when a list)
+    and mu_sh in shear."""
     record = json.loads((directory / "case.json").read_text())
     s = record["setup"]
     area = math.pi * s["radius"] ** 2
@@ -339,7 +342,8 @@ def write_shear_table(directory: Path, mu_psh: float, mu_sh: float, rho_b: float
             travel = seg["offset_start"] + (step - seg["start_step"]) * seg["travel_per_step"]
             lid = seg["target_force"]
             weight = rho_b * 9.81 * area * (lid_z - s["z_shear"])
-            mu = {1: mu_psh, 3: mu_sh}.get(seg["phase"], 0.0)
+            psh = mu_psh[seg["cycle"]] if isinstance(mu_psh, list) else mu_psh
+            mu = {1: psh, 3: mu_sh}.get(seg["phase"], 0.0)
             upper_z, flange_z = 0.3 * lid, -0.02 * lid
             shear = mu * (lid + weight + upper_z + flange_z)
             rows.append(
@@ -366,10 +370,14 @@ def test_extract_shear_cell_recovers_known_values(tmp_path: Path) -> None:
 
 def test_extract_shear_cell_cycles_in_one_deck(tmp_path: Path) -> None:
     render_case("shear_cell", CASE, tiny(), tmp_path)
-    write_shear_table(tmp_path, mu_psh=0.7, mu_sh=0.6, rho_b=1500.0)
+    # Four pre-shears at one stress read 0.66-0.74: the deck's pre-shear point is their mean.
+    write_shear_table(tmp_path, mu_psh=[0.66, 0.70, 0.74, 0.72], mu_sh=0.6, rho_b=1500.0)
     table = extract("shear_cell", tmp_path)
     assert table["P"].tolist() == [0.4, 0.6, 0.8, 1.0]
     assert table["mu_sh"].to_numpy() == pytest.approx([0.6] * 4, rel=1e-9)
+    assert table["mu_psh_cycle"].to_numpy() == pytest.approx([0.66, 0.70, 0.74, 0.72], rel=1e-9)
+    assert table["mu_psh"].to_numpy() == pytest.approx([0.705] * 4, rel=1e-9)
+    assert table["rho_b"].to_numpy() == pytest.approx([1500.0] * 4, rel=1e-9)
 
 
 def test_extract_names_a_missing_or_truncated_output(tmp_path: Path) -> None:
