@@ -163,7 +163,7 @@ def _preshear_point(values: pd.DataFrame) -> pd.DataFrame:
     pre-shears of all its cycles.
 
     Every cycle pre-shears at the same normal stress to the same steady state, so its readings
-    are repeated measurements of one point (a ring tester reports their mean), and their mean
+    are repeated measurements of the yield locus's single pre-shear point, and their mean
     scatters half as much over four cycles. Each cycle's own reading stays in
     ``mu_psh_cycle`` and ``rho_b_cycle``; a cycle without a steady pre-shear plateau (NaN)
     does not count.
