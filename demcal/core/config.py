@@ -208,19 +208,6 @@ def _shear_cell_problems(config: Mapping[str, Any]) -> list[str]:
     return problems
 
 
-def _design_problems(config: Mapping[str, Any]) -> list[str]:
-    """``design`` keys that only work with some kinds of study."""
-    design = config.get("design", {})
-    if not design.get("repose_extra_sets"):
-        return []
-    if design.get("kind") == "factorial":
-        return ["design.repose_extra_sets: needs a random, lhs or sobol design, not factorial"]
-    if config.get("sequential", {}).get("enabled"):
-        # The rounds choose every set for both tests; heap-only sets would be runs outside them.
-        return ["design.repose_extra_sets: must be 0 in a sequential study (sequential.enabled)"]
-    return []
-
-
 def validate_config(config: dict, source: str) -> dict:
     """Validate a workflow configuration (``config/*.yaml``) in place and return it.
 
@@ -233,7 +220,7 @@ def validate_config(config: dict, source: str) -> dict:
         Listing every violation with its dotted key path.
     """
     validate(config, "config.schema.yaml", source)
-    problems = parameter_problems(config) + _shear_cell_problems(config) + _design_problems(config)
+    problems = parameter_problems(config) + _shear_cell_problems(config)
     if problems:
         lines = "\n  ".join(problems)
         raise ConfigError(f"{source}: invalid configuration:\n  {lines}")

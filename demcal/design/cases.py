@@ -55,9 +55,14 @@ def design_from_config(config: Mapping[str, Any]) -> pd.DataFrame:
 
 
 def repose_extra_sets(config: Mapping[str, Any]) -> int:
-    """Sets of the design on which only the angle of repose runs (0 for a factorial design)."""
+    """Sets of the design on which only the angle of repose runs.
+
+    0 for a factorial design and in a sequential study, whose rounds choose every set for both
+    tests: the key is ignored there, as it is when a profile merged over the quick one
+    inherits it.
+    """
     section = config["design"]
-    if section.get("kind") == "factorial":
+    if section.get("kind") == "factorial" or config.get("sequential", {}).get("enabled"):
         return 0
     return int(section.get("repose_extra_sets", 0))
 

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.core.config import load_config, validate_config
+from demcal.core.config import load_config
 from demcal.design.build import (
     build_design,
     factorial_design,
@@ -339,15 +339,10 @@ def test_heap_only_sets_follow_the_shared_sets() -> None:
     assert study_case_ids(quick, design, "angle_of_repose") == case_ids(n + extra)
     shear = study_case_ids(quick, design, "shear_cell")
     assert shear == [f"{c}_s{k}" for c in case_ids(n) for k in (1, 2, 3)]
-    # Heap-only sets need a sampled design, and a sequential study chooses every set itself.
-    for change, key in (
-        (
-            {"design": {"kind": "factorial", "levels": {"coefficientFriction": [0.2, 0.4]}}},
-            "factorial",
-        ),
-        ({"sequential": {"enabled": True}}, "sequential"),
-    ):
-        raw = {"design": {"repose_extra_sets": 4}}
-        raw = {**raw, **change, "design": {**raw["design"], **change.get("design", {})}}
-        with pytest.raises(ValueError, match=rf"design\.repose_extra_sets.*{key}"):
-            validate_config(raw, "t")
+    # A factorial design and a sequential study's rounds choose every set for both tests: the
+    # key is ignored there (a profile merged over the quick one inherits it).
+    paper = load_config(root / "config" / "paper.yaml")
+    paper["design"]["repose_extra_sets"] = 48
+    assert len(design_from_config(paper)) == 3 * 3 * 3 * 3 * 4
+    sequential = {**quick, "sequential": {**quick["sequential"], "enabled": True}}
+    assert len(design_from_config(sequential)) == n
