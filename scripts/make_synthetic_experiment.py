@@ -6,7 +6,7 @@ engine), so that the measurements come from another code than the model under ca
 Usage: python scripts/make_synthetic_experiment.py --config config/tiny.yaml \\
     --truth config/experiments/truth/synthetic_reference.yaml \\
     --out config/experiments/synthetic_reference_tiny.yaml [--noise 0.01] [--seed 1] \\
-    [--truth-engine "liggghts -in {deck}"]
+    [--truth-engine "liggghts -in {deck}"] [--normal-stresses 2029]
 """
 
 import argparse
@@ -27,6 +27,12 @@ def main() -> None:
     )
     parser.add_argument("--P", default=None, help="shear load fractions to keep, comma-separated")
     parser.add_argument(
+        "--normal-stresses",
+        default=None,
+        help="normal stresses (Pa) of the shear-cell truth runs, comma-separated "
+        "(default: the profile's shear_cell.normal_stresses)",
+    )
+    parser.add_argument(
         "--truth-engine",
         default=installed_liggghts(),
         help="command template of the truth runs (default: 'liggghts -in {deck}' when "
@@ -42,6 +48,9 @@ def main() -> None:
         observables=args.observables.split(","),
         p_values=[float(p) for p in args.P.split(",")] if args.P else None,
         truth_engine=args.truth_engine,
+        normal_stresses=(
+            [float(s) for s in args.normal_stresses.split(",")] if args.normal_stresses else None
+        ),
     )
     print(f"wrote {args.out}")
 

@@ -125,6 +125,7 @@ def write_synthetic_experiment(
     observables: Sequence[str] = ("mu_psh", "mu_sh", "rho_b"),
     p_values: Sequence[float] | None = None,
     truth_engine: str | None = None,
+    normal_stresses: Sequence[float] | None = None,
 ) -> Path:
     """Run the virtual tests at the true parameters of a truth file and write an experiment
     file.
@@ -143,6 +144,9 @@ def write_synthetic_experiment(
         Command template of the truth runs (e.g. ``liggghts -in {deck}``), so that the
         measurements come from another code than the model under calibration; default the
         configuration's ``engine.command``.
+    normal_stresses : sequence of float, optional
+        Normal stresses (Pa) of the shear-cell truth runs, instead of the configuration's
+        ``shear_cell.normal_stresses`` (one run per stress, so fewer stresses cost fewer runs).
 
     Returns
     -------
@@ -152,6 +156,13 @@ def write_synthetic_experiment(
     config = load_config(config_path)
     if truth_engine is not None:
         config["engine"] = {**config["engine"], "command": truth_engine}
+    stresses = ""
+    if normal_stresses is not None:
+        config["shear_cell"] = {
+            **config["shear_cell"],
+            "normal_stresses": [float(value) for value in normal_stresses],
+        }
+        stresses = " at " + ", ".join(f"{value:g}" for value in normal_stresses) + " Pa"
     engine = str(config["engine"]["command"])
     truth = yaml.safe_load(Path(truth_path).read_text())
     with tempfile.TemporaryDirectory() as tmp:
@@ -161,7 +172,7 @@ def write_synthetic_experiment(
         f"{truth['material']} ({config['profile']} profile)",
         noise,
         seed,
-        f"`{engine}` at the parameters of {Path(truth_path).name}, {config_path}, "
+        f"`{engine}` at the parameters of {Path(truth_path).name}, {config_path}{stresses}, "
         f"noise {noise:.1%}",
         observables=tuple(observables),
         p_values=tuple(float(p) for p in p_values) if p_values else None,
