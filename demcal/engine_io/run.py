@@ -4,6 +4,7 @@ import json
 import os
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -11,6 +12,27 @@ from pathlib import Path
 
 #: Warning lines kept in a run's ``status.json``.
 MAX_WARNINGS = 20
+
+#: Signals by which a run is stopped from outside (Ctrl-C, a stopped study, a cancelled or
+#: timed-out batch job): such a run says nothing about its deck.
+INTERRUPTS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+class RunInterrupted(RuntimeError):
+    """The engine was stopped by a signal from outside; no status is recorded, so the run
+    starts again when the study resumes."""
+
+
+def interrupting_signal(returncode: int) -> signal.Signals | None:
+    """The interrupting signal behind ``returncode``, or None.
+
+    A process killed by signal N returns -N to Python; through a shell, ``timeout
+    --preserve-status`` or a batch wrapper it exits with 128 + N.
+    """
+    for sig in INTERRUPTS:
+        if returncode in (-int(sig), 128 + int(sig)):
+            return sig
+    return None
 
 
 def installed_liggghts() -> str | None:
@@ -94,6 +116,13 @@ def run_deck(case_dir: str | Path, deck: str, template: str, threads: int) -> di
     error line), not raised, so that one bad case does not stop a study; a missing engine is a
     set-up error and raises ``FileNotFoundError`` before anything is written.
 
+    Raises
+    ------
+    RunInterrupted
+        When the engine was stopped by SIGINT, SIGTERM or SIGHUP (see :data:`INTERRUPTS`):
+        nothing is recorded, so a resumed study runs the deck again instead of counting it
+        as failed.
+
     Returns
     -------
     dict
@@ -108,6 +137,14 @@ def run_deck(case_dir: str | Path, deck: str, template: str, threads: int) -> di
         proc = subprocess.run(cmd, cwd=case_dir, stdout=out, stderr=err, env=env, check=False)
         returncode = proc.returncode
     seconds = time.monotonic() - start
+    stopped_by = interrupting_signal(returncode)
+    if stopped_by is not None:
+        (case_dir / "status.json").unlink(missing_ok=True)
+        raise RunInterrupted(
+            f"{case_dir / deck}: the engine was stopped by {stopped_by.name} after "
+            f"{seconds:.0f} s (exit code {returncode}); nothing recorded, the run starts again "
+            "when the study resumes"
+        )
     errors = error_lines(case_dir)
     status = {
         "status": "ok" if returncode == 0 else "failed",
