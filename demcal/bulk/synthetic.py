@@ -116,6 +116,32 @@ def experiment_record(
     return record
 
 
+def truth_run_config(
+    config: Mapping[str, Any],
+    truth_engine: str | None = None,
+    normal_stresses: Sequence[float] | None = None,
+) -> dict[str, Any]:
+    """The configuration of the truth runs: ``config`` with another engine command and other
+    shear-cell normal stresses where given (the input is not changed).
+
+    Raises
+    ------
+    ValueError
+        When a normal stress is not a positive finite number (Pa), or none is given.
+    """
+    out = dict(config)
+    if truth_engine is not None:
+        out["engine"] = {**config["engine"], "command": truth_engine}
+    if normal_stresses is not None:
+        values = [float(value) for value in normal_stresses]
+        if not values or not all(np.isfinite(v) and v > 0 for v in values):
+            raise ValueError(
+                f"--normal-stresses {normal_stresses!r}: give one or more positive stresses in Pa"
+            )
+        out["shear_cell"] = {**config["shear_cell"], "normal_stresses": values}
+    return out
+
+
 def write_synthetic_experiment(
     config_path: str | Path,
     truth_path: str | Path,
@@ -153,15 +179,9 @@ def write_synthetic_experiment(
     Path
         ``out_path``.
     """
-    config = load_config(config_path)
-    if truth_engine is not None:
-        config["engine"] = {**config["engine"], "command": truth_engine}
+    config = truth_run_config(load_config(config_path), truth_engine, normal_stresses)
     stresses = ""
     if normal_stresses is not None:
-        config["shear_cell"] = {
-            **config["shear_cell"],
-            "normal_stresses": [float(value) for value in normal_stresses],
-        }
         stresses = " at " + ", ".join(f"{value:g}" for value in normal_stresses) + " Pa"
     engine = str(config["engine"]["command"])
     truth = yaml.safe_load(Path(truth_path).read_text())
