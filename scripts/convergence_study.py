@@ -37,7 +37,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from demcal.bulk.convergence import FACTORS, plan_study, quantities_of, summarise  # noqa: E402
+from demcal.bulk.convergence import (  # noqa: E402
+    FACTORS,
+    parse_parameter_set,
+    plan_study,
+    quantities_of,
+    summarise,
+)
 from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     collect_values,
@@ -46,6 +52,7 @@ from demcal.bulk.engine_comparison import (  # noqa: E402
     run_jobs,
 )
 from demcal.core.config import load_config  # noqa: E402
+from demcal.core.parameters import PARAMETERS  # noqa: E402
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -53,7 +60,19 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--config", default="config/config.yaml", help="configuration YAML")
     parser.add_argument("--factors", nargs="+", default=list(FACTORS), help="factors to vary")
     parser.add_argument(
-        "--sets", nargs="+", default=["low", "middle", "high"], help="reference parameter sets"
+        "--sets",
+        nargs="*",
+        default=["low", "middle", "high"],
+        help="reference parameter sets (none with --sets alone: only the --extra-set ones)",
+    )
+    parser.add_argument(
+        "--extra-set",
+        action="append",
+        default=[],
+        metavar="NAME=key:value,...",
+        help="a further parameter set, e.g. where a calibration landed (every contact "
+        "parameter: coefficientFriction, coefficientRollingFriction, coefficientRestitution, "
+        "density); repeatable",
     )
     parser.add_argument("--seeds", type=int, default=3, help="seeds per level and set")
     parser.add_argument("--normal-stress", type=float, default=10070.0, help="pre-shear, Pa")
@@ -91,6 +110,10 @@ def _plot(summary: pd.DataFrame, name: str, label: str, path: Path) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _set_text(params: dict[str, float]) -> str:
+    return "(" + ", ".join(f"{PARAMETERS[k].symbol} {v:g}" for k, v in params.items()) + ")"
 
 
 def _markdown(summary: pd.DataFrame, header: str) -> str:
@@ -145,7 +168,20 @@ def main(argv: list[str] | None = None) -> int:
         raise SystemExit(f"unknown factors {unknown}; choose from {sorted(FACTORS)}")
     settings = load_config(Path(args.config))
     available = parameter_sets(str(settings.get("profile", "quick")))
+    unknown_sets = [name for name in args.sets if name not in available]
+    if unknown_sets:
+        raise SystemExit(f"unknown sets {unknown_sets}; choose from {sorted(available)}")
     sets = {name: available[name] for name in args.sets}
+    for text in args.extra_set:
+        try:
+            name, params = parse_parameter_set(text)
+        except ValueError as exc:
+            raise SystemExit(f"--extra-set: {exc}") from None
+        if name in sets:
+            raise SystemExit(f"--extra-set: a set named {name} is already in the study")
+        sets[name] = params
+    if not sets:
+        raise SystemExit("no parameter sets: name some with --sets or add one with --extra-set")
     factors = [FACTORS[name] for name in args.factors]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -182,7 +218,9 @@ def main(argv: list[str] | None = None) -> int:
             _plot(summary, factor.name, factor.label, out / f"{factor.name}.png")
     failed = values[values["status"] != "ok"].drop_duplicates(["factor", "level", "set", "seed"])
     header = (
-        f"Config {args.config}, sets {', '.join(args.sets)}, seeds {seeds}, shear cell at "
+        f"Config {args.config}, sets "
+        + ", ".join(f"{name} {_set_text(params)}" for name, params in sets.items())
+        + f", seeds {seeds}, shear cell at "
         f"{args.normal_stress:g} Pa and P = {args.P:g}; started {started:%Y-%m-%d %H:%M} UTC, "
         f"wall time of this call {(time.monotonic() - t0) / 60:.1f} min, "
         f"{len(unique)} distinct runs, {len(failed)} without values."

@@ -3,16 +3,25 @@
 from __future__ import annotations
 
 import json
+import re
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.bulk.convergence import FACTORS, Factor, plan_study, summarise
+from demcal.bulk.convergence import FACTORS, Factor, parse_parameter_set, plan_study, summarise
 from demcal.core.config import load_config
 
 ROOT = Path(__file__).resolve().parents[2]
+MIDDLE = {
+    "coefficientFriction": 0.6,
+    "coefficientRollingFriction": 0.3,
+    "coefficientRestitution": 0.6,
+    "density": 2500.0,
+}
 SET = {
     "coefficientFriction": 0.5,
     "coefficientRollingFriction": 0.2,
@@ -147,3 +156,63 @@ def test_every_factor_level_renders_on_the_quick_profile(tmp_path: Path) -> None
             geometry = overrides.get("shear_cell.geometry", "ring")
             assert record["setup"]["geometry"] == geometry
             assert record["setup"]["cycle_mode"] == ("continue" if geometry == "ring" else "return")
+
+
+def test_parse_parameter_set_reads_every_contact_parameter() -> None:
+    name, params = parse_parameter_set(
+        "sinter=coefficientFriction:0.557, coefficientRollingFriction:0.919,"
+        "coefficientRestitution:0.703,density:3116,cohesionEnergyDensity:2e4"
+    )
+    assert name == "sinter"
+    assert params == {
+        "coefficientFriction": 0.557,
+        "coefficientRollingFriction": 0.919,
+        "coefficientRestitution": 0.703,
+        "density": 3116.0,
+        "cohesionEnergyDensity": 20000.0,
+    }
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("coefficientFriction:0.5", "expected NAME=key:value"),
+        ("a/b=coefficientFriction:0.5", "NAME without '/'"),
+        ("s=coefficientFriction 0.5", "is not key:value"),
+        ("s=coefficientFricton:0.5", "did you mean coefficientFriction"),
+        ("s=youngsModulus:1e7", "not a contact parameter"),
+        ("s=coefficientFriction:0.5,coefficientFriction:0.6", "given twice"),
+        ("s=coefficientFriction:high", "'high' is not a number"),
+        ("s=coefficientRestitution:1.5", "coefficientRestitution = 1.5 is outside"),
+        ("s=coefficientFriction:0.5,density:3000", "missing coefficientRollingFriction"),
+    ],
+)
+def test_parse_parameter_set_names_what_is_wrong(text: str, message: str) -> None:
+    with pytest.raises(ValueError, match=re.escape(message)):
+        parse_parameter_set(text)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--sets"], "no parameter sets"),
+        (["--sets", "medium"], "unknown sets ['medium']"),
+        (["--extra-set", "s=coefficientFriction:0.5"], "--extra-set: parameter set s: missing"),
+        (
+            ["--extra-set", "middle=" + ",".join(f"{k}:{v}" for k, v in MIDDLE.items())],
+            "a set named middle is already in the study",
+        ),
+    ],
+)
+def test_convergence_script_stops_on_bad_sets_before_any_run(
+    tmp_path: Path, args: list[str], message: str
+) -> None:
+    out = tmp_path / "study"
+    res = subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "convergence_study.py"), *args, "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert res.returncode != 0 and message in res.stderr, res.stderr
+    assert not out.exists()

@@ -57,7 +57,6 @@ _SNAKEMAKE_ONE = {
     "--executor",
     "-e",
     "--latency-wait",
-    "--rerun-triggers",
 }
 _SNAKEMAKE_MANY = {
     "--configfile",
@@ -66,6 +65,7 @@ _SNAKEMAKE_MANY = {
     "-C",
     "--default-resources",
     "--resources",
+    "--rerun-triggers",
     "--set-threads",
     "--set-resources",
     "--forcerun",
