@@ -193,9 +193,12 @@ def main(argv: list[str] | None = None) -> int:
     }
     started = datetime.now(UTC)
     t0 = time.monotonic()
-    planned = plan_study(
-        settings, sets, factors, seeds, out / "cases", render=not args.collect_only, **options
-    )
+    try:
+        planned = plan_study(
+            settings, sets, factors, seeds, out / "cases", render=not args.collect_only, **options
+        )
+    except ValueError as exc:
+        raise SystemExit(str(exc)) from None
     unique = {job.case_dir: job for job, _, _ in planned}
     jobs = [job for d, job in unique.items() if not (d / "status.json").is_file()]
     if jobs and not args.collect_only:

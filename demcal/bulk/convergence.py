@@ -16,6 +16,7 @@ step, finest particles) is its reference.
 from __future__ import annotations
 
 import copy
+import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -340,6 +341,7 @@ def plan_study(
                     case_dir = Path(out_dir) / factor.test / key / set_name / f"seed{seed}"
                     job = planned.get(case_dir)
                     if job is None:
+                        _check_earlier_run(case_dir, params)
                         if render and not (case_dir / "status.json").is_file():
                             run_cfg = dict(cfg)
                             run_cfg["seed"] = int(seed)
@@ -348,6 +350,25 @@ def plan_study(
                         planned[case_dir] = job
                     out.append((job, factor.name, overrides))
     return out
+
+
+def _check_earlier_run(case_dir: Path, params: Mapping[str, float]) -> None:
+    """Refuse to reuse a run made earlier for a set of the same name but other values."""
+    record = case_dir / "case.json"
+    if not record.is_file():
+        return
+    earlier = json.loads(record.read_text()).get("case", {})
+    differ = [
+        f"{key} {earlier.get(key)} (now {value:g})"
+        for key, value in params.items()
+        if earlier.get(key) is None or not math.isclose(float(earlier[key]), value, rel_tol=1e-9)
+    ]
+    if differ:
+        raise ValueError(
+            f"{case_dir}: made earlier for set {case_dir.parent.name} with "
+            + ", ".join(differ)
+            + "; give the set another name or use another output directory"
+        )
 
 
 def _deviation(quantity: str, value: float, reference: float) -> float:

@@ -75,6 +75,11 @@ def test_levels_are_applied_and_the_base_run_is_shared(tmp_path: Path) -> None:
     deck.write_text("kept\n")
     plan_study(settings, {"a": SET}, [size], [1], tmp_path, "dem_engine -in {deck}", 2029.0)
     assert deck.read_text() == "kept\n"
+    # Nor is it taken for a set of the same name with other values: that stops the study.
+    other = {**SET, "coefficientFriction": SET["coefficientFriction"] + 0.1}
+    with pytest.raises(ValueError, match=r"seed1: made earlier for set a with coefficientFriction"):
+        plan_study(settings, {"a": other}, [size], [1], tmp_path, "dem_engine -in {deck}", 2029.0)
+    assert deck.read_text() == "kept\n" and status.is_file()
 
 
 def test_summary_measures_distance_to_the_most_refined_level() -> None:
