@@ -31,9 +31,9 @@ from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     collect_values,
     load_status,
-    parameter_sets,
     plan_runs,
     run_jobs,
+    select_parameter_sets,
 )
 from demcal.bulk.engine_statistics import (  # noqa: E402
     compare_engines,
@@ -111,17 +111,16 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
     settings = load_config(Path(args.config))
-    available = parameter_sets(str(settings.get("profile", "tiny")))
-    unknown = [s for s in args.sets if s not in available]
-    if unknown:
-        raise SystemExit(f"unknown parameter sets {unknown}; choose from {sorted(available)}")
+    try:
+        sets = select_parameter_sets(args.sets, str(settings.get("profile", "tiny")))
+    except ValueError as exc:
+        raise SystemExit(str(exc)) from None
     names = set(args.engines) | set(args.compare)
     if any(e not in ENGINE_COMMANDS for e in names):
         raise SystemExit(f"engines must be among {sorted(ENGINE_COMMANDS)}")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     seeds = list(range(args.first_seed, args.first_seed + args.seeds))
-    sets = {name: available[name] for name in args.sets}
     engines = {name: ENGINE_COMMANDS[name] for name in args.engines}
     if "engine" in engines:
         # A private copy of the engine binary, so that a rebuild during the runs cannot mix

@@ -48,8 +48,8 @@ from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     collect_values,
     load_status,
-    parameter_sets,
     run_jobs,
+    select_parameter_sets,
 )
 from demcal.core.config import load_config  # noqa: E402
 from demcal.core.parameters import PARAMETERS  # noqa: E402
@@ -167,11 +167,10 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         raise SystemExit(f"unknown factors {unknown}; choose from {sorted(FACTORS)}")
     settings = load_config(Path(args.config))
-    available = parameter_sets(str(settings.get("profile", "quick")))
-    unknown_sets = [name for name in args.sets if name not in available]
-    if unknown_sets:
-        raise SystemExit(f"unknown sets {unknown_sets}; choose from {sorted(available)}")
-    sets = {name: available[name] for name in args.sets}
+    try:
+        sets = select_parameter_sets(args.sets, str(settings.get("profile", "quick")))
+    except ValueError as exc:
+        raise SystemExit(str(exc)) from None
     for text in args.extra_set:
         try:
             name, params = parse_parameter_set(text)

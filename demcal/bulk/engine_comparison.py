@@ -37,6 +37,7 @@ __all__ = [
     "parameter_sets",
     "plan_runs",
     "run_jobs",
+    "select_parameter_sets",
 ]
 
 #: Bulk values compared, with the test they come from.
@@ -106,6 +107,33 @@ def parameter_sets(profile: str = "tiny") -> dict[str, dict[str, float]]:
             "cohesionEnergyDensity": cohesion,
         },
     }
+
+
+def select_parameter_sets(names: Sequence[str], profile: str) -> dict[str, dict[str, float]]:
+    """The named sets of :func:`parameter_sets`, in the order given.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Set names (``low``, ``middle``, ``high``, ``interlocking``, ``cohesion``).
+    profile : str
+        Configuration profile, as for :func:`parameter_sets`.
+
+    Returns
+    -------
+    dict
+        Set name -> contact parameters.
+
+    Raises
+    ------
+    ValueError
+        A name is not a set; the message lists the unknown names and the choices.
+    """
+    available = parameter_sets(profile)
+    unknown = [name for name in names if name not in available]
+    if unknown:
+        raise ValueError(f"unknown parameter sets {unknown}; choose from {sorted(available)}")
+    return {name: available[name] for name in names}
 
 
 @dataclass

@@ -201,7 +201,7 @@ def test_parse_parameter_set_names_what_is_wrong(text: str, message: str) -> Non
     ("args", "message"),
     [
         (["--sets"], "no parameter sets"),
-        (["--sets", "medium"], "unknown sets ['medium']"),
+        (["--sets", "medium"], "unknown parameter sets ['medium']"),
         (["--extra-set", "s=coefficientFriction:0.5"], "--extra-set: parameter set s: missing"),
         (
             ["--extra-set", "middle=" + ",".join(f"{k}:{v}" for k, v in MIDDLE.items())],
