@@ -36,6 +36,7 @@ from demcal.engine_io.vtk_file import read_vtk_particles
 from demcal.robustness.base_decks import with_quick_ring
 from demcal.virtual_tests.deck import DECK_NAMES, render_case
 from demcal.virtual_tests.shear_cell.plane_stress import plane_stress_series
+from tests.engine.conftest import TEST_RAYLEIGH_FRACTION
 
 from .conftest import LiggghtsRun, run_liggghts, unexpected_warnings
 
@@ -81,7 +82,9 @@ SHEAR_CASES: dict[str, tuple[dict[str, Any], dict[str, dict[str, Any]]]] = {
 
 
 def settings(overrides: dict[str, dict[str, Any]] | None = None) -> dict[str, Any]:
+    """The tiny profile at the tests' time step, with ``overrides`` merged per section."""
     cfg = load_config(ROOT / "config" / "tiny.yaml")
+    cfg["material"]["rayleigh_fraction"] = TEST_RAYLEIGH_FRACTION
     for section, values in (overrides or {}).items():
         cfg[section].update(values)
     return cfg
@@ -160,6 +163,7 @@ def test_ring_shear_cell_deck_runs_on_two_mpi_ranks(tmp_path: Path) -> None:
     # (the next pre-shear follows the shear in the same direction). A shorter settling keeps
     # the run short when the two ranks share busy cores.
     cfg = with_quick_ring(ROOT / "config" / "tiny.yaml")
+    cfg["material"]["rayleigh_fraction"] = TEST_RAYLEIGH_FRACTION
     assert cfg["shear_cell"]["cycles"] == "continue"
     cfg["shear_cell"].update(settle_fall_times=1.0, P=TWO_CYCLES)
     record = render_case("shear_cell", {**BASE, "normal_stress": STRESS}, cfg, tmp_path)

@@ -11,6 +11,7 @@ import yaml
 
 from demcal.core.config import load_config
 from demcal.sequential.rounds import round_case_ids, runs_per_set, verification_runs
+from tests.engine.conftest import TEST_RAYLEIGH_FRACTION
 from tests.figures import read_png
 from tests.workflow.test_tiny_workflow import scratch_study, snakemake
 
@@ -35,6 +36,7 @@ def study(tmp_path_factory):
     # smaller cells than the tiny profile: the loop is under test here, not the bulk values
     config["shear_cell"]["dCylDp"] = 8
     config["angle_of_repose"]["dCylDp"] = 8
+    config["material"]["rayleigh_fraction"] = TEST_RAYLEIGH_FRACTION
     # One shear deck per set (2 runs per set) with the measured P = 1 and one shear point.
     config["shear_cell"]["separate_runs"] = False
     config["shear_cell"]["P"] = [0.6, 1.0]
