@@ -97,6 +97,13 @@ def disc(
 ) -> np.ndarray:
     """Horizontal polygonal disc (triangle fan around the centre).
 
+    A fan keeps every rim vertex in two triangles that share an edge. Cutting the polygon into
+    ears instead gives fewer triangles per particle (AoR runs about 10 % faster), but puts rim
+    vertices into three or more coplanar triangles, where a particle can touch one triangle's
+    face and another's (active) corner at once. With such discs the tiny split cell's
+    mu_sh - mu_psh fell to -0.16 +- 0.05 (four seeds, 2026-11-27; a critical state gives no
+    drop), on the engine and, by the bulk-parity test, on LIGGGHTS alike.
+
     Parameters
     ----------
     radius : float
