@@ -18,8 +18,8 @@ At 50 kJ/m^3 the tiny cohesive heaps stood as columns (aor about 100 deg) on bot
 20 kJ/m^3 gives heaps of 38-59 deg.
 
 Three seeds are too few: LIGGGHTS' rho_b of mu_s 0.3 against 0.9 (93 kg/m^3 apart, sd 5 and 16)
-then gave p = 0.006, not below the 0.0025 of the test. About 3 minutes on two otherwise idle
-cores (48 runs at 20 % of the Rayleigh time); more when the cores are shared. The quick
+then gave p = 0.006, not below the 0.0025 of the test. About 3-4 minutes on two otherwise
+idle cores (48 runs at 20 % of the Rayleigh time); more when the cores are shared. The quick
 profile: `scripts/compare_engines.py`, docs/benchmarks.md.
 """
 
