@@ -194,8 +194,10 @@ def test_paraview_files(finished):
     _, setup = load_case(run)
     vtk = out / "vtk"
     # by step (not by name: particles_7760 would follow particles_31040)
-    particles = sorted(vtk.glob("particles_*.vtk"), key=lambda p: int(p.stem.split("_")[1]))
-    boxes = sorted(vtk.glob("boxes_*.vtk"), key=lambda p: int(p.stem.split("_")[1]))
+    particles, boxes = (
+        sorted(vtk.glob(f"{kind}_*.vtk"), key=lambda p: int(p.stem.split("_")[1]))
+        for kind in ("particles", "boxes")
+    )
     # one file at step 0 and n_vtk more
     assert len(particles) == config["application"]["n_vtk"] + 1
     assert {p.name.split("_")[1] for p in particles} == {p.name.split("_")[1] for p in boxes}
