@@ -49,6 +49,10 @@ void find_mesh_contacts(const Vec3& x, double r, const TriRef* refs, int n,
   const double r2 = r * r;
   for (int k = 0; k < n; ++k) {
     const TriMesh& mesh = *meshes[refs[k].mesh];
+    // Every point of the triangle is at least as far as its plane: most candidates end here.
+    const TrianglePlane& plane = mesh.plane(refs[k].tri);
+    const double s = dot(x - mesh.node(refs[k].tri, 0), plane.n);
+    if (s * s >= r2 * plane.area2) continue;
     const ClosestPoint cp = mesh.contact_point(refs[k].tri, x);
     const Vec3 d = x - cp.point;
     const double d2 = norm2(d);

@@ -22,6 +22,7 @@ TriMesh::TriMesh(const std::vector<Triangle>& triangles, const std::string& sour
     for (const Vec3& p : v) nodes_.push_back(p);
   }
   velocities_.assign(nodes_.size(), Vec3{});
+  update_planes();
   reject_duplicates(source);
   set_curvature(kDefaultCurvatureDegrees, source);
 }
@@ -77,14 +78,24 @@ std::vector<Triangle> TriMesh::triangles() const {
   return out;
 }
 
+void TriMesh::update_planes() {
+  // Recomputed from the moved nodes rather than carried along, so that the planes are what the
+  // nodes give, to the last bit, after any number of motions.
+  planes_.resize(size());
+  for (std::size_t t = 0; t < size(); ++t)
+    planes_[t] = triangle_plane(node(t, 0), node(t, 1), node(t, 2));
+}
+
 void TriMesh::scale(double factor) {
   for (Vec3& p : nodes_) p *= factor;
+  update_planes();
   ++version_;
 }
 
 void TriMesh::translate(const Vec3& d, std::size_t first_frame) {
   for (Vec3& p : nodes_) p += d;
   for (std::size_t k = first_frame; k < frames_.size(); ++k) frames_[k].origin += d;
+  update_planes();
   ++version_;
 }
 
@@ -95,6 +106,7 @@ void TriMesh::rotate(const Vec3& unit_axis, double angle, const Vec3& center,
     frames_[k].origin = center + rotate_about_axis(frames_[k].origin - center, unit_axis, angle);
     frames_[k].axis = rotate_about_axis(frames_[k].axis, unit_axis, angle);
   }
+  update_planes();
   ++version_;
 }
 

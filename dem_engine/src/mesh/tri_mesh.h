@@ -34,8 +34,10 @@ class TriMesh {
   // Contact point of a sphere centred at p with triangle `tri`, as LIGGGHTS finds it.
   ClosestPoint contact_point(std::size_t tri, const Vec3& p) const {
     return contact_point_on_triangle(p, nodes_[3 * tri], nodes_[3 * tri + 1], nodes_[3 * tri + 2],
-                                     topology_.face_tolerance(tri));
+                                     planes_[tri], topology_.face_tolerance(tri));
   }
+  // Plane of triangle `tri` at the nodes' current positions.
+  const TrianglePlane& plane(std::size_t tri) const { return planes_[tri]; }
   // Velocity of the surface at a point given by barycentric weights (m/s). Exact for rigid
   // motions, whose velocity field is affine in the position.
   Vec3 velocity_at(std::size_t tri, const ClosestPoint& cp) const {
@@ -79,11 +81,13 @@ class TriMesh {
   std::vector<Vec3> nodes_;
   std::vector<Vec3> velocities_;
   std::vector<Frame> frames_;
+  std::vector<TrianglePlane> planes_;  // one per triangle, renewed by every motion
   MeshTopology topology_;
   long version_ = 0;
   bool moving_ = false;
 
   void reject_duplicates(const std::string& source) const;
+  void update_planes();
 };
 
 }  // namespace dem

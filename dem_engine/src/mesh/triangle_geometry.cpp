@@ -79,21 +79,38 @@ ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3&
   return r;
 }
 
+TrianglePlane triangle_plane(const Vec3& a, const Vec3& b, const Vec3& c) {
+  TrianglePlane t;
+  t.n = cross(b - a, c - a);
+  t.area2 = norm2(t.n);
+  if (!(t.area2 > 0.0)) return t;
+  // The weight of a at q in the plane is the area of (q, b, c) over that of (a, b, c):
+  // ((c - b) x (q - b)) . n / |n|^2 = (q - b) . (n x (c - b)) / |n|^2; likewise for b and c.
+  const double inv = 1.0 / t.area2;
+  t.grad[0] = inv * cross(t.n, c - b);
+  t.grad[1] = inv * cross(t.n, a - c);
+  t.grad[2] = inv * cross(t.n, b - a);
+  return t;
+}
+
 ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
                                        const Vec3& c, double tolerance) {
+  return contact_point_on_triangle(p, a, b, c, triangle_plane(a, b, c), tolerance);
+}
+
+ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                       const Vec3& c, const TrianglePlane& plane,
+                                       double tolerance) {
   ClosestPoint r;
   r.point = a;
-  const Vec3 n = cross(b - a, c - a);
-  const double area2 = norm2(n);
-  if (!(area2 > 0.0)) return r;
-  const Vec3 q = p - (dot(p - a, n) / area2) * n;  // projection onto the plane
-  const double w[3] = {dot(cross(b - q, c - q), n) / area2, dot(cross(c - q, a - q), n) / area2,
-                       dot(cross(a - q, b - q), n) / area2};
+  if (!(plane.area2 > 0.0)) return r;
+  const double w[3] = {dot(p - b, plane.grad[0]), dot(p - c, plane.grad[1]),
+                       dot(p - a, plane.grad[2])};
   const Vec3* v[3] = {&a, &b, &c};
   const double lim = -tolerance;
   const int negative = (w[0] < lim) + (w[1] < lim) + (w[2] < lim);
   if (negative == 0) {
-    r.point = q;
+    r.point = p - (dot(p - a, plane.n) / plane.area2) * plane.n;  // projection onto the plane
     r.wa = w[0];
     r.wb = w[1];
     r.wc = w[2];

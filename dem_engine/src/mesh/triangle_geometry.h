@@ -27,6 +27,18 @@ struct ClosestPoint {
 // triangle's features. Degenerate triangles are handled (the result is a point of a segment).
 ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
+// What contact_point_on_triangle needs of a triangle a, b, c besides its nodes, fixed while the
+// triangle keeps its shape and orientation: with it a query costs dot products only.
+struct TrianglePlane {
+  Vec3 n;              // (b - a) x (c - a) (m^2)
+  double area2 = 0.0;  // |n|^2, zero for a degenerate triangle (m^4)
+  // Gradients of the barycentric weights of a, b and c in the plane (1/m): the weight of a is
+  // (p - b) . grad[0], of b (p - c) . grad[1], of c (p - a) . grad[2], for any p (the part of
+  // p - x along n does not count).
+  Vec3 grad[3];
+};
+TrianglePlane triangle_plane(const Vec3& a, const Vec3& b, const Vec3& c);
+
 // The contact point of a sphere centred at p with the triangle as LIGGGHTS 3.8 finds it, from the
 // barycentric coordinates of p projected onto the plane of the triangle, counting those below
 // -tolerance as negative: none negative, the projection (face); one negative, the closest point
@@ -36,6 +48,9 @@ ClosestPoint closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3&
 // first vertex.
 ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
                                        double tolerance);
+// The same with the plane of a, b, c computed beforehand (triangle_plane).
+ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                                       const TrianglePlane& plane, double tolerance);
 
 // Unit normal (b - a) x (c - a) / |...|; the zero vector for a degenerate triangle.
 Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
