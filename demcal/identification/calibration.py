@@ -4,6 +4,7 @@ Three screenings as in the paper's Table 5: the shear-cell conditions alone (SSC
 repose alone (AoR), and both (shear-cell conditions, then AoR on the marked sets).
 """
 
+import gzip
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
@@ -161,11 +162,32 @@ def valid_sets_file(out_dir: str | Path, group: str) -> Path:
     return Path(out_dir) / f"valid_{name}.csv.gz"
 
 
+def csv_text(frame: pd.DataFrame) -> str:
+    """``frame`` as CSV text (header, no index), numbers to 6 significant digits.
+
+    Each distinct value of a column is formatted once: the valid sets of a grid hold a few
+    dozen values per parameter over up to millions of rows, and formatting every cell took
+    most of the identification's time.
+    """
+    columns = []
+    for name in frame.columns:
+        codes, distinct = pd.factorize(frame[name])
+        text = np.array([f"{value:.6g}" for value in distinct], dtype=object)
+        columns.append(pd.Series(text[codes], dtype=object))
+    header = ",".join(map(str, frame.columns))
+    if not columns or len(frame) == 0:
+        return header + "\n"
+    rows = columns[0].str.cat(columns[1:], sep=",") if len(columns) > 1 else columns[0]
+    return "\n".join([header, *rows.tolist()]) + "\n"
+
+
 def write_valid_sets(result: CalibrationResult, out_dir: str | Path) -> dict[str, Path]:
-    """Valid sets per group as compressed CSV (:func:`valid_sets_file`)."""
+    """Valid sets per group as gzip-compressed CSV (:func:`valid_sets_file`)."""
     paths = {}
     for group, frame in result.valid.items():
         path = valid_sets_file(out_dir, group)
-        frame.to_csv(path, index=False, float_format="%.6g")
+        # Level 6 (gzip's default): 5 % larger files than level 9 in a quarter of the time.
+        with gzip.open(path, "wt", compresslevel=6, newline="") as out:
+            out.write(csv_text(frame))
         paths[group] = path
     return paths

@@ -1,5 +1,6 @@
 """Case enumeration, engine runs with status records, the tidy dataset, experiments, calibration."""
 
+import gzip
 import json
 import math
 from pathlib import Path
@@ -23,7 +24,12 @@ from demcal.design.cases import (
     verification_case_ids,
 )
 from demcal.engine_io.run import engine_command, run_deck
-from demcal.identification.calibration import ConstantInputs, calibrate
+from demcal.identification.calibration import (
+    CalibrationResult,
+    ConstantInputs,
+    calibrate,
+    write_valid_sets,
+)
 from demcal.identification.verification import verification_table
 from demcal.identification.verification_run import write_verification_table
 from tests.engine.conftest import engine_path
@@ -253,6 +259,30 @@ def test_calibration_recovers_truth_with_analytic_surrogates():
     assert set(both["coefficientRestitution"]) == set(result.axes["coefficientRestitution"])
     assert result.identified_group == "SSC & AoR"
     assert result.identified["density"]["mean"] == pytest.approx(3000.0, rel=0.05)
+
+
+def test_valid_sets_written_read_back_to_six_digits(tmp_path):
+    rng = np.random.default_rng(4)
+    grid = np.linspace(0.1, 1.0, 37)
+    frame = pd.DataFrame(
+        {
+            "coefficientFriction": rng.choice(grid, 500),
+            "density": rng.uniform(2500.0, 3500.0, 500),  # every value distinct
+        }
+    )
+    empty = frame.iloc[:0]
+    result = CalibrationResult(
+        {}, {"SSC": frame, "SSC & AoR": empty}, 500, 0.0, pd.DataFrame(), {}, "SSC"
+    )
+    paths = write_valid_sets(result, tmp_path)
+    assert paths["SSC & AoR"].name == "valid_ssc_aor.csv.gz"
+    back = pd.read_csv(paths["SSC"])
+    assert list(back.columns) == list(frame.columns) and len(back) == 500
+    np.testing.assert_allclose(back.to_numpy(), frame.to_numpy(), rtol=5e-6)
+    # The same text as pandas writes with the same format.
+    with gzip.open(paths["SSC"], "rt") as text:
+        assert text.read() == frame.to_csv(index=False, float_format="%.6g")
+    assert list(pd.read_csv(paths["SSC & AoR"]).columns) == list(frame.columns)
 
 
 def test_calibration_names_unscreened_varying_input():
