@@ -270,6 +270,7 @@ def test_valid_sets_written_read_back_to_six_digits(tmp_path):
             "density": rng.uniform(2500.0, 3500.0, 500),  # every value distinct
         }
     )
+    frame.loc[[3, 70], "density"] = np.nan  # written as empty fields, as pandas does
     empty = frame.iloc[:0]
     result = CalibrationResult(
         {}, {"SSC": frame, "SSC & AoR": empty}, 500, 0.0, pd.DataFrame(), {}, "SSC"
@@ -278,7 +279,7 @@ def test_valid_sets_written_read_back_to_six_digits(tmp_path):
     assert paths["SSC & AoR"].name == "valid_ssc_aor.csv.gz"
     back = pd.read_csv(paths["SSC"])
     assert list(back.columns) == list(frame.columns) and len(back) == 500
-    np.testing.assert_allclose(back.to_numpy(), frame.to_numpy(), rtol=5e-6)
+    np.testing.assert_allclose(back.to_numpy(), frame.to_numpy(), rtol=5e-6)  # NaN == NaN
     # The same text as pandas writes with the same format.
     with gzip.open(paths["SSC"], "rt") as text:
         assert text.read() == frame.to_csv(index=False, float_format="%.6g")
