@@ -98,11 +98,13 @@ def disc(
     """Horizontal polygonal disc (triangle fan around the centre).
 
     A fan keeps every rim vertex in two triangles that share an edge. Cutting the polygon into
-    ears instead gives fewer triangles per particle (AoR runs about 10 % faster), but puts rim
-    vertices into three or more coplanar triangles, where a particle can touch one triangle's
-    face and another's (active) corner at once. With such discs the tiny split cell's
-    mu_sh - mu_psh fell to -0.16 +- 0.05 (four seeds, 2026-11-27; a critical state gives no
-    drop), on the engine and, by the bulk-parity test, on LIGGGHTS alike.
+    ears instead gives fewer triangles per particle (AoR runs about 10 % faster), but with such
+    discs the tiny split cell's mu_sh - mu_psh fell to -0.16 +- 0.05 (four seeds, 2026-11-27; a
+    critical state gives no drop), on the engine and, by the bulk-parity test, on LIGGGHTS
+    alike. Why is not established: a point inside a convex polygon lies inside every rim edge,
+    so a rim vertex shared by three or more coplanar, edge-connected triangles should not give
+    a second (corner) contact; long, thin ears and the coplanar-neighbour hand-over of contact
+    histories between triangles that share only a vertex are the open candidates.
 
     Parameters
     ----------
