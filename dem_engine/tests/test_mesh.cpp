@@ -319,6 +319,63 @@ TEST_CASE("mesh: closest point equals a brute-force search on random triangles")
   CHECK(vertices > 1000);
 }
 
+TEST_CASE("mesh: contact points from a kept plane; the plane cut drops no contact") {
+  std::mt19937 rng(2718);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto rv = [&] { return Vec3{u(rng), u(rng), u(rng)}; };
+  int bad_weights = 0, bad_face = 0, dropped = 0, cut = 0, faces = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const Vec3 a = rv(), b = rv(), c = rv(), p = 1.5 * rv();
+    if (dem::triangle_area(a, b, c) < 1e-3) continue;
+    const dem::TrianglePlane plane = dem::triangle_plane(a, b, c);
+    const ClosestPoint cp = dem::contact_point_on_triangle(p, a, b, c, plane, 0.0);
+    // The weights give the point, in every region.
+    const Vec3 from_weights = cp.wa * a + cp.wb * b + cp.wc * c;
+    if (norm(from_weights - cp.point) > 1e-12) ++bad_weights;
+    // On the face the contact point is the closest point of the triangle.
+    if (cp.on_face()) {
+      ++faces;
+      if (norm(dem::closest_point_on_triangle(p, a, b, c).point - cp.point) > 1e-12) ++bad_face;
+    }
+    // A sphere whose plane distance is at least its radius touches no point of the triangle.
+    const double r = 0.5 * (u(rng) + 1.0);
+    const double s = dot(p - a, plane.n);
+    if (s * s >= r * r * plane.area2) {
+      ++cut;
+      if (norm(p - brute_closest(p, a, b, c)) < r * (1.0 - 1e-12)) ++dropped;
+    }
+  }
+  CHECK_EQ(bad_weights, 0);
+  CHECK_EQ(bad_face, 0);
+  CHECK_EQ(dropped, 0);
+  CHECK(faces > 1000);
+  CHECK(cut > 1000);
+}
+
+TEST_CASE("mesh: the planes kept by a mesh are those of its nodes after every motion") {
+  TriMesh tube(cylinder_mesh(0.5, 0.0, 1.0, 12), "tube");
+  auto planes_match = [&] {
+    int off = 0;
+    for (std::size_t t = 0; t < tube.size(); ++t) {
+      const dem::TrianglePlane fresh =
+          dem::triangle_plane(tube.node(t, 0), tube.node(t, 1), tube.node(t, 2));
+      const dem::TrianglePlane& kept = tube.plane(t);
+      // Bit for bit: the kept plane is recomputed from the moved nodes, not carried along.
+      if (!(kept.n.x == fresh.n.x && kept.n.y == fresh.n.y && kept.n.z == fresh.n.z &&
+            kept.area2 == fresh.area2 && kept.grad[2].x == fresh.grad[2].x))
+        ++off;
+    }
+    return off;
+  };
+  CHECK_EQ(planes_match(), 0);
+  tube.translate(Vec3{0.1, -0.2, 0.3});
+  CHECK_EQ(planes_match(), 0);
+  tube.rotate(Vec3{0.0, 0.6, 0.8}, 0.7, Vec3{0.2, 0.0, 0.0});
+  CHECK_EQ(planes_match(), 0);
+  tube.scale(2.5);
+  CHECK_EQ(planes_match(), 0);
+}
+
 // --- contacts: active edges and corners, coplanar patches (LIGGGHTS rules) ---------------------
 
 TEST_CASE("mesh: a sphere on two coplanar triangles has one contact") {
