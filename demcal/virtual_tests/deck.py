@@ -204,6 +204,72 @@ def _distribution_record(dist: SizeDistribution) -> dict[str, Any]:
     }
 
 
+def case_setup(
+    test: str, case: Mapping[str, Any], settings: Mapping[str, Any]
+) -> tuple[dict[str, Any], float, SizeDistribution, Any, ShearCellSetup | ReposeSetup]:
+    """The validated case and every derived quantity of its deck, nothing written.
+
+    Parameters
+    ----------
+    test, case, settings
+        As for :func:`render_case`.
+
+    Returns
+    -------
+    tuple
+        The case as plain values, the cell size dCylDp, the size distribution, the material
+        set-up and the test's set-up.
+
+    Raises
+    ------
+    ValueError, CaseValidationError, MissingColumnError, SetupError
+        As :func:`render_case`.
+    """
+    if test not in TESTS:
+        raise ValueError(f"unknown test {test!r}; expected one of {', '.join(TESTS)}")
+    plain = _plain_case(case)
+    section = settings[test]
+    material = settings["material"]
+    youngs = float(plain.get("youngsModulus", material["youngsModulus"]))
+    if test == "shear_cell" and isinstance(plain.get("normal_stress"), numbers.Real):
+        youngs = shear_cell_youngs_modulus(plain, material, section)
+    _validate(test, plain, settings, youngs)
+    dCylDp = float(plain.get("dCylDp", section["dCylDp"]))
+    dist = size_distribution(settings["particles"])
+    mat = material_setup(plain, material, dist, youngs)
+    # A replicate run (verification) carries its own insertion seed.
+    seed = int(plain.get("seed", settings["seed"]))
+    skin = float(settings["material"]["skin"])
+    if test == "shear_cell":
+        # A case row with a load condition P runs that single cycle.
+        cell = dict(section)
+        if "P" in plain:
+            cell["P"] = [float(plain["P"])]
+        setup: ShearCellSetup | ReposeSetup = shear_cell_setup(
+            dCylDp, float(plain["normal_stress"]), dist, mat, cell, seed, skin
+        )
+    else:
+        setup = repose_setup(dCylDp, dist, mat, section, seed, skin)
+    return plain, dCylDp, dist, mat, setup
+
+
+def particle_steps(test: str, case: Mapping[str, Any], settings: Mapping[str, Any]) -> float:
+    """What a case costs to run: particles inserted times time steps of its deck.
+
+    Parameters
+    ----------
+    test, case, settings
+        As for :func:`render_case`.
+
+    Returns
+    -------
+    float
+        Particle-steps (a DEM run's time is about proportional to them).
+    """
+    setup = case_setup(test, case, settings)[-1]
+    return float(setup.n_particles) * float(setup.total_steps)
+
+
 def render_case(
     test: str, case: Mapping[str, Any], settings: Mapping[str, Any], out_dir: Path
 ) -> dict[str, Any]:
@@ -245,29 +311,9 @@ def render_case(
     demcal.core.config_values.SetupError
         For settings that make the set-up impossible (names the configuration key).
     """
-    if test not in TESTS:
-        raise ValueError(f"unknown test {test!r}; expected one of {', '.join(TESTS)}")
-    plain = _plain_case(case)
+    plain, dCylDp, dist, mat, setup = case_setup(test, case, settings)
     section = settings[test]
-    material = settings["material"]
-    youngs = float(plain.get("youngsModulus", material["youngsModulus"]))
-    if test == "shear_cell" and isinstance(plain.get("normal_stress"), numbers.Real):
-        youngs = shear_cell_youngs_modulus(plain, material, section)
-    _validate(test, plain, settings, youngs)
-    dCylDp = float(plain.get("dCylDp", section["dCylDp"]))
-    dist = size_distribution(settings["particles"])
-    mat = material_setup(plain, material, dist, youngs)
-    # A replicate run (verification) carries its own insertion seed.
-    seed = int(plain.get("seed", settings["seed"]))
-    skin = float(settings["material"]["skin"])
-    if test == "shear_cell":
-        # A case row with a load condition P runs that single cycle.
-        cell = dict(section)
-        if "P" in plain:
-            cell["P"] = [float(plain["P"])]
-        setup: ShearCellSetup | ReposeSetup = shear_cell_setup(
-            dCylDp, float(plain["normal_stress"]), dist, mat, cell, seed, skin
-        )
+    if isinstance(setup, ShearCellSetup):
         if setup.geometry == "ring":
             files = dict(RING_FILES)
             meshes = _ring_meshes(setup)
@@ -288,7 +334,6 @@ def render_case(
             "min_fraction": float(section["plateau_min_fraction"]),
         }
     else:
-        setup = repose_setup(dCylDp, dist, mat, section, seed, skin)
         files = dict(REPOSE_FILES)
         meshes = _repose_meshes(setup)
         template = "angle_of_repose.in.j2"

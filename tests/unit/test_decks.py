@@ -19,7 +19,7 @@ from demcal.decks.render import format_number, template_environment
 from demcal.decks.stl_file import read_stl
 from demcal.decks.triangle_surface import surface_area
 from demcal.robustness.base_decks import with_quick_ring
-from demcal.virtual_tests.deck import render_case
+from demcal.virtual_tests.deck import particle_steps, render_case
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -498,3 +498,30 @@ def test_ring_meshes_have_the_cell_geometry(tmp_path: Path) -> None:
     upper_in = read_stl(tmp_path / "meshes" / "ring_upper_inner.stl").triangles
     assert upper_in[..., 2].min() == pytest.approx(s["z_shear"])
     assert upper_in[..., 2].max() == pytest.approx(s["wall_top"])
+
+
+# ---------------------------------------------------------------------------------------------
+# run cost for scheduling (workflow/rules/common.smk: run_priority)
+
+
+def test_particle_steps_are_the_rendered_decks_and_rank_runs_by_cost(tmp_path: Path) -> None:
+    # The cost is the rendered deck's: particles inserted times the steps of its runs.
+    record = render_case("angle_of_repose", CASE, tiny(), tmp_path / "heap")
+    heap = particle_steps("angle_of_repose", CASE, tiny())
+    assert heap == record["setup"]["n_particles"] * sum(
+        run_lengths((tmp_path / "heap" / "in.angle_of_repose").read_text())
+    )
+    # Tiny profile: a heap is about 4 shear runs (14 s against 3.5 s measured side by side,
+    # docs/benchmarks.md), so heaps start first.
+    shear = particle_steps("shear_cell", {**CASE, "P": 1.0}, tiny())
+    assert 3.0 < heap / shear < 6.0
+    # Quick profile: the ring decks take longer the higher the stress (stiffer particles,
+    # smaller time step: 170 / 224 / 537 s) and all longer than a heap (51 s), so they start
+    # first there.
+    quick = load_config(ROOT / "config" / "config.yaml")
+    rings = [
+        particle_steps("shear_cell", {**CASE, "normal_stress": s, "P": 1.0}, quick)
+        for s in quick["shear_cell"]["normal_stresses"]
+    ]
+    assert rings == sorted(rings)
+    assert rings[0] > particle_steps("angle_of_repose", CASE, quick)

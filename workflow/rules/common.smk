@@ -16,7 +16,9 @@ from demcal.core.config import validate_config
 from demcal.core.experiments import load_experiment
 from demcal.core.rule_log import rule_log
 from demcal.design.table import read_design_table
-from demcal.virtual_tests.deck import render_case
+from functools import cache
+
+from demcal.virtual_tests.deck import particle_steps, render_case
 from demcal.sequential.rounds import check_sequential, round_case_ids, round_of_case
 
 validate_config(config, source=", ".join(str(f) for f in workflow.configfiles) or "config")
@@ -159,6 +161,30 @@ def engine_threads(stage):
     if stage.startswith("verification/"):
         return VERIFICATION_THREADS
     return config["engine"]["threads"]
+
+
+@cache
+def design_costs():
+    """Particle-steps of every case of the configured design, by test and case id."""
+    return {
+        test: {
+            case: particle_steps(test, case_row(config, DESIGN, test, case), config)
+            for case in CASES[test]
+        }
+        for test in TESTS
+    }
+
+
+def run_priority(wildcards):
+    """Scheduling priority of a DEM run: its particle-steps in millions, so that the longest
+    runs start first and no core idles at the end of a stage while one long run finishes
+    (longest-first scheduling). Cases outside the configured design (verification, later
+    sequential rounds, probes) count as the design's mean run of their test."""
+    costs = design_costs()[wildcards.test]
+    if not costs:
+        return 0
+    mean = sum(costs.values()) / len(costs)
+    return round(costs.get(wildcards.case, mean) / 1e6, 3)
 
 
 def resource(kind, key, default):

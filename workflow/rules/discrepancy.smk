@@ -56,6 +56,7 @@ rule discrepancy_render_probe:
         info=f"{DISC}/probes/{{test}}/{{case}}/case.json",
     log:
         f"{LOGS}/render/discrepancy/probes/{{test}}/{{case}}.log",
+    priority: run_priority  # that of its run (simulate.smk)
     localrule: True
     run:
         # In-process, like render_case: a new interpreter per run costs more than rendering.
@@ -103,6 +104,7 @@ rule discrepancy_render_extended:
         info=f"{DISC}/extended/{{test}}/{{case}}/case.json",
     log:
         f"{LOGS}/render/discrepancy/extended/{{test}}/{{case}}.log",
+    priority: run_priority  # that of its run (simulate.smk)
     localrule: True
     run:
         render_discrepancy_run(
@@ -192,6 +194,7 @@ rule discrepancy_render_verification:
         info=f"{DISC}/verification/{{test}}/{{case}}/case.json",
     log:
         f"{LOGS}/render/discrepancy/verification/{{test}}/{{case}}.log",
+    priority: run_priority  # that of its run (simulate.smk)
     localrule: True
     run:
         render_discrepancy_run(

@@ -63,6 +63,7 @@ rule render_verification:
         info=f"{RESULTS}/verification/{{engine}}/{{test}}/{{case}}/case.json",
     log:
         f"{LOGS}/render/verification/{{engine}}/{{test}}/{{case}}.log",
+    priority: run_priority  # that of its run (simulate.smk)
     localrule: True
     conda:
         CONDA_ENV

@@ -120,6 +120,7 @@ rule sequential_render_verification:
         info=f"{SEQ_ROUND}/verification/{{test}}/{{case}}/case.json",
     log:
         f"{LOGS}/render/sequential/round_{{round}}/{{test}}/{{case}}.log",
+    priority: run_priority  # that of its run (simulate.smk)
     wildcard_constraints:
         round=r"\d+",
     localrule: True

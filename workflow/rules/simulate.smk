@@ -11,6 +11,8 @@ rule render_case:
         info=f"{RESULTS}/cases/{{test}}/{{case}}/case.json",
     log:
         f"{LOGS}/render/{{test}}/{{case}}.log",
+    # The run's priority: a run can start first only if its deck was rendered first.
+    priority: run_priority
     localrule: True
     run:
         # In-process: a new interpreter per case would cost more than the rendering.
@@ -34,6 +36,7 @@ rule run_case:
     params:
         command=lambda wildcards: engine_command(wildcards.stage),
     threads: lambda wildcards: engine_threads(wildcards.stage)
+    priority: run_priority
     resources:
         runtime=resource("dem_case", "runtime", 60),
         mem_mb=resource("dem_case", "mem_mb", 2000),
