@@ -258,13 +258,17 @@ def particle_steps(test: str, case: Mapping[str, Any], settings: Mapping[str, An
 
     Parameters
     ----------
-    test, case, settings
-        As for :func:`render_case`.
+    test : str
+        One of :data:`TESTS`.
+    case : mapping
+        The case row (contact parameters, load condition, optional seed).
+    settings : mapping
+        The validated configuration.
 
     Returns
     -------
     float
-        Particle-steps (a DEM run's time is about proportional to them).
+        Particle-steps, from the set-up alone (a DEM run's time is about proportional to them).
     """
     setup = case_setup(test, case, settings)[-1]
     return float(setup.n_particles) * float(setup.total_steps)

@@ -1,5 +1,6 @@
 # Shared set-up: validated configuration, the case list and output locations.
 import json
+from functools import cache
 from pathlib import Path
 
 from demcal.core.parameters import TESTS
@@ -16,8 +17,6 @@ from demcal.core.config import validate_config
 from demcal.core.experiments import load_experiment
 from demcal.core.rule_log import rule_log
 from demcal.design.table import read_design_table
-from functools import cache
-
 from demcal.virtual_tests.deck import particle_steps, render_case
 from demcal.sequential.rounds import check_sequential, round_case_ids, round_of_case
 
