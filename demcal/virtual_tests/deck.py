@@ -22,7 +22,7 @@ from demcal.decks.case_validation import ValidationRules, validate_case
 from demcal.decks.mesh_primitives import annulus, cylinder_shell, disc, quad
 from demcal.decks.render import render_deck, write_case_directory
 from demcal.decks.triangle_surface import merge
-from demcal.particles.material import material_record, material_setup
+from demcal.particles.material import MaterialSetup, material_record, material_setup
 from demcal.particles.size_distribution import SizeDistribution, size_distribution
 from demcal.virtual_tests.angle_of_repose.setup import ReposeSetup, repose_setup
 from demcal.virtual_tests.shear_cell.setup import (
@@ -37,6 +37,8 @@ __all__ = [
     "RING_FILES",
     "SHEAR_FILES",
     "TESTS",
+    "case_setup",
+    "particle_steps",
     "render_case",
 ]
 
@@ -206,7 +208,7 @@ def _distribution_record(dist: SizeDistribution) -> dict[str, Any]:
 
 def case_setup(
     test: str, case: Mapping[str, Any], settings: Mapping[str, Any]
-) -> tuple[dict[str, Any], float, SizeDistribution, Any, ShearCellSetup | ReposeSetup]:
+) -> tuple[dict[str, Any], float, SizeDistribution, MaterialSetup, ShearCellSetup | ReposeSetup]:
     """The validated case and every derived quantity of its deck, nothing written.
 
     Parameters
