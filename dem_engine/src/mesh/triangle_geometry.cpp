@@ -94,11 +94,6 @@ TrianglePlane triangle_plane(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
-                                       const Vec3& c, double tolerance) {
-  return contact_point_on_triangle(p, a, b, c, triangle_plane(a, b, c), tolerance);
-}
-
-ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
                                        const Vec3& c, const TrianglePlane& plane,
                                        double tolerance) {
   ClosestPoint r;

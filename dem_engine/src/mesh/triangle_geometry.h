@@ -45,10 +45,7 @@ TrianglePlane triangle_plane(const Vec3& a, const Vec3& b, const Vec3& c);
 // of the opposite edge (kEdge..., also when that is one of its end points); two negative, the
 // remaining vertex. Differs from closest_point_on_triangle in the region reported, at obtuse
 // angles in the point, and within the tolerance of an edge. Degenerate triangles give their
-// first vertex.
-ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
-                                       double tolerance);
-// The same with the plane of a, b, c computed beforehand (triangle_plane).
+// first vertex. `plane` is triangle_plane(a, b, c), computed beforehand.
 ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
                                        const TrianglePlane& plane, double tolerance);
 
