@@ -163,15 +163,17 @@ def engine_threads(stage):
 
 
 @cache
-def design_costs():
-    """Particle-steps of every case of the configured design, by test and case id."""
-    return {
-        test: {
-            case: particle_steps(test, case_row(config, DESIGN, test, case), config)
-            for case in CASES[test]
-        }
-        for test in TESTS
-    }
+def design_case_cost(test, case):
+    """Particle-steps of one case of the configured design (each computed once, when asked:
+    a cluster job's Snakemake process needs only its own)."""
+    return particle_steps(test, case_row(config, DESIGN, test, case), config)
+
+
+@cache
+def mean_design_cost(test):
+    """Mean particle-steps of the configured design's cases of `test` (0 without any)."""
+    costs = [design_case_cost(test, case) for case in CASES[test]]
+    return sum(costs) / len(costs) if costs else 0.0
 
 
 def run_priority(wildcards):
@@ -179,11 +181,11 @@ def run_priority(wildcards):
     runs start first and no core idles at the end of a stage while one long run finishes
     (longest-first scheduling). Cases outside the configured design (verification, later
     sequential rounds, probes) count as the design's mean run of their test."""
-    costs = design_costs()[wildcards.test]
-    if not costs:
-        return 0
-    mean = sum(costs.values()) / len(costs)
-    return round(costs.get(wildcards.case, mean) / 1e6, 3)
+    if wildcards.case in CASES[wildcards.test]:
+        cost = design_case_cost(wildcards.test, wildcards.case)
+    else:
+        cost = mean_design_cost(wildcards.test)
+    return round(cost / 1e6, 3)
 
 
 def resource(kind, key, default):
