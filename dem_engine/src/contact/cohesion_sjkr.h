@@ -12,7 +12,7 @@ namespace dem {
 // force from it as well.
 struct CohesionSjkr {
   template <class R>
-  static R contact_area(const ContactInputT<R>& c) {
+  DEM_INLINE static R contact_area(const ContactInputT<R>& c) {
     if (c.wall) return M_PI * (c.ri * c.ri - c.dist * c.dist);
     const R r = c.dist;
     const R prod =

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "contact/cohesion_none.h"
@@ -76,6 +77,26 @@ void parse_pair_model(const std::vector<std::string>& w, std::size_t pos, ModelS
 
 namespace {
 
+// A pack whose lane l is f(l).
+template <class P, class F>
+DEM_INLINE P lanes_of(F f) {
+  if constexpr (std::is_same_v<P, Pack2>) return P(f(0), f(1));
+  else return P(f(0), f(1), f(2), f(3));
+}
+
+// The material parameters of the pack's contacts, lane l from q[l].
+template <class P>
+DEM_INLINE PairParamsT<P> pack_params(const PairParams* const* q) {
+  PairParamsT<P> p;
+  p.y_star = lanes_of<P>([&](int l) { return q[l]->y_star; });
+  p.g_star = lanes_of<P>([&](int l) { return q[l]->g_star; });
+  p.beta = lanes_of<P>([&](int l) { return q[l]->beta; });
+  p.mu_s = lanes_of<P>([&](int l) { return q[l]->mu_s; });
+  p.mu_r = lanes_of<P>([&](int l) { return q[l]->mu_r; });
+  p.cohesion = lanes_of<P>([&](int l) { return q[l]->cohesion; });
+  return p;
+}
+
 template <class Cohesion, class Rolling, class R>
 DEM_INLINE void contact_law(const ContactInputT<R>& c, const PairParamsT<R>& p,
                         const ContactStep& step, R* history, ContactResultT<R>& result) {
@@ -98,7 +119,7 @@ class ComposedModel final : public ContactModel {
   void wall_forces(const Particles& P, const MaterialTable& material, const ContactStep& step,
                    const WallContact* contacts, std::size_t count,
                    ContactResult* results) const override {
-    for (std::size_t h = 0; h < count; h += kLanes)
+    for (std::size_t h = 0; h < count; h += kWallLanes)
       wall_pack(P, material, step, contacts, h, h + 1 < count, results);
   }
 
@@ -109,8 +130,13 @@ class ComposedModel final : public ContactModel {
   }
 
  private:
-  using Pack = Pack2;
-  static constexpr int kLanes = 2;
+  // Pairs run four at a time (one AVX instruction per operation where the CPU has AVX): the
+  // contact law is a chain of square roots and divisions, and four independent contacts
+  // keep more of them in flight than two. Walls, a few per cent of the time, run in pairs.
+  using Pack = Pack4;
+  static constexpr int kLanes = 4;
+  using WallPack = Pack2;
+  static constexpr int kWallLanes = 2;
   static constexpr int kBatch = 128;  // contacts per batch: its buffers stay in L1
 
   // Touching pairs waiting for their contact law: particle i, its partner j, the list entry k,
@@ -131,15 +157,16 @@ class ComposedModel final : public ContactModel {
     int size = 0;
     // The material parameters of the last pack, reused while the type pairs repeat (always,
     // with one particle type).
-    const PairParams* params_of[2] = {nullptr, nullptr};
+    const PairParams* params_of[kLanes] = {};
     PairParamsT<Pack> params;
   };
 
-  // The contact law of batch entries e0 and e1 in one pack (e1 = e0 for a lone last contact,
-  // whose second lane is then dropped). Packs are filled straight from the particle arrays.
+  // The contact law of batch entries e0 .. e0 + count - 1 (count <= kLanes) in one pack; the
+  // lanes past count repeat the last contact and are dropped. Packs are filled straight from
+  // the particle arrays.
   template <bool Periodic>
   DEM_AVX_CLONES void contact_pack(const PairForceArgs& a, const ContactStep& step, Batch& b,
-                                   int e0, bool two) const {
+                                   int e0, int count) const {
     const Particles& P = a.atoms;
     const Vec3* x = P.x.data();
     const Vec3* v = P.v.data();
@@ -147,67 +174,86 @@ class ComposedModel final : public ContactModel {
     const double* rad = P.radius.data();
     const double* mass = P.rmass.data();
     using V = Vec3T<Pack>;
-    const int e1 = two ? e0 + 1 : e0;
-    const auto i0 = static_cast<std::size_t>(b.i[e0]), i1 = static_cast<std::size_t>(b.i[e1]);
-    const auto j0 = static_cast<std::size_t>(b.j[e0]), j1 = static_cast<std::size_t>(b.j[e1]);
-    auto pack3 = [](const Vec3& p0, const Vec3& p1) {
-      return V{Pack(p0.x, p1.x), Pack(p0.y, p1.y), Pack(p0.z, p1.z)};
+    std::size_t ii[kLanes], jj[kLanes];
+    int kk[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      const auto e = static_cast<std::size_t>(e0 + std::min(l, count - 1));
+      ii[l] = static_cast<std::size_t>(b.i[e]);
+      jj[l] = static_cast<std::size_t>(b.j[e]);
+      kk[l] = b.k[e];
+    }
+    auto pack1 = [&](const double* of, const std::size_t* idx) {
+      return lanes_of<Pack>([&](int l) { return of[idx[l]]; });
+    };
+    auto pack3 = [&](const Vec3* of, const std::size_t* idx) {
+      return V{lanes_of<Pack>([&](int l) { return of[idx[l]].x; }),
+               lanes_of<Pack>([&](int l) { return of[idx[l]].y; }),
+               lanes_of<Pack>([&](int l) { return of[idx[l]].z; })};
     };
     ContactInputT<Pack> c;
     V d;
     if constexpr (Periodic) {
-      d = pack3(a.domain.minimum_image(x[i0] - x[j0]), a.domain.minimum_image(x[i1] - x[j1]));
+      Vec3 dl[kLanes];
+      for (int l = 0; l < kLanes; ++l) dl[l] = a.domain.minimum_image(x[ii[l]] - x[jj[l]]);
+      d = V{lanes_of<Pack>([&](int l) { return dl[l].x; }),
+            lanes_of<Pack>([&](int l) { return dl[l].y; }),
+            lanes_of<Pack>([&](int l) { return dl[l].z; })};
     } else {
-      d = pack3(x[i0], x[i1]) - pack3(x[j0], x[j1]);
+      d = pack3(x, ii) - pack3(x, jj);
     }
     const Pack r = lane_sqrt(norm2(d));
-    c.ri = Pack(rad[i0], rad[i1]);
-    c.rj = Pack(rad[j0], rad[j1]);
+    c.ri = pack1(rad, ii);
+    c.rj = pack1(rad, jj);
     const Pack radsum = c.ri + c.rj;
     c.dist = r;
     c.n = (1.0 / r) * d;
     c.overlap = radsum - r;
     c.r_eff = c.ri * c.rj / radsum;
-    Pack mi(mass[i0], mass[i1]), mj(mass[j0], mass[j1]);
+    Pack mi = pack1(mass, ii), mj = pack1(mass, jj);
     if (a.freeze_bit) {  // rare: a pair with a frozen particle has the other's mass
-      double m[2][2] = {{mass[i0], mass[j0]}, {mass[i1], mass[j1]}};
-      const std::size_t ij[2][2] = {{i0, j0}, {i1, j1}};
-      for (int l = 0; l < 2; ++l) {
-        if (P.mask[ij[l][0]] & a.freeze_bit) m[l][0] = 0.0, m[l][1] = mass[ij[l][1]];
-        if (P.mask[ij[l][1]] & a.freeze_bit) m[l][0] = mass[ij[l][0]], m[l][1] = 0.0;
+      double m[kLanes][2];
+      for (int l = 0; l < kLanes; ++l) {
+        m[l][0] = mass[ii[l]];
+        m[l][1] = mass[jj[l]];
+        if (P.mask[ii[l]] & a.freeze_bit) m[l][0] = 0.0, m[l][1] = mass[jj[l]];
+        if (P.mask[jj[l]] & a.freeze_bit) m[l][0] = mass[ii[l]], m[l][1] = 0.0;
       }
-      mi = Pack(m[0][0], m[1][0]);
-      mj = Pack(m[0][1], m[1][1]);
+      mi = lanes_of<Pack>([&](int l) { return m[l][0]; });
+      mj = lanes_of<Pack>([&](int l) { return m[l][1]; });
     }
     c.m_eff = m_effective(mi, mj, a.freeze_bit != 0);
     c.cri = c.ri - 0.5 * c.overlap;
     c.crj = c.rj - 0.5 * c.overlap;
-    c.v_rel = pack3(v[i0], v[i1]) - pack3(v[j0], v[j1]);
-    c.omega_i = pack3(w[i0], w[i1]);
-    c.omega_j = pack3(w[j0], w[j1]);
-    const PairParams* q0 = &a.material.get(P.type[i0], P.type[j0]);
-    const PairParams* q1 = &a.material.get(P.type[i1], P.type[j1]);
-    if (q0 != b.params_of[0] || q1 != b.params_of[1]) {
-      b.params = pack_params(*q0, *q1);
-      b.params_of[0] = q0;
-      b.params_of[1] = q1;
+    c.v_rel = pack3(v, ii) - pack3(v, jj);
+    c.omega_i = pack3(w, ii);
+    c.omega_j = pack3(w, jj);
+    const PairParams* q[kLanes];
+    bool same = true;
+    for (int l = 0; l < kLanes; ++l) {
+      q[l] = &a.material.get(P.type[ii[l]], P.type[jj[l]]);
+      same = same && q[l] == b.params_of[l];
+    }
+    if (!same) {
+      b.params = pack_params<Pack>(q);
+      for (int l = 0; l < kLanes; ++l) b.params_of[l] = q[l];
     }
     const PairParamsT<Pack>& p = b.params;
-    double* h0 = a.list.history.data() + static_cast<std::size_t>(b.k[e0]) * kHistorySize;
-    double* h1 = a.list.history.data() + static_cast<std::size_t>(b.k[e1]) * kHistorySize;
+    double* h[kLanes];
+    for (int l = 0; l < kLanes; ++l)
+      h[l] = a.list.history.data() + static_cast<std::size_t>(kk[l]) * kHistorySize;
     Pack hist[kHistorySize];
-    for (int q = 0; q < kHistorySize; ++q) hist[q] = Pack(h0[q], h1[q]);
+    for (int q6 = 0; q6 < kHistorySize; ++q6)
+      hist[q6] = lanes_of<Pack>([&](int l) { return h[l][q6]; });
     ContactResultT<Pack> res;
     contact_law<Cohesion, Rolling>(c, p, step, hist, res);
-    for (int q = 0; q < kHistorySize; ++q) h0[q] = hist[q][0];
-    if (two)
-      for (int q = 0; q < kHistorySize; ++q) h1[q] = hist[q][1];
-    // Whole packs are stored; a dropped lane lands in the spare entry past the batch.
+    for (int l = 0; l < count; ++l)
+      for (int q6 = 0; q6 < kHistorySize; ++q6) h[l][q6] = hist[q6][l];
+    // Whole packs are stored; dropped lanes land in the spare entries past the batch.
     const Pack* results[10] = {&res.force.x,    &res.force.y,    &res.force.z,
                                &res.torque_i.x, &res.torque_i.y, &res.torque_i.z,
                                &res.torque_j.x, &res.torque_j.y, &res.torque_j.z,
                                &c.overlap};
-    for (int q = 0; q < 10; ++q) results[q]->store(&b.out[q][static_cast<std::size_t>(e0)]);
+    for (int o = 0; o < 10; ++o) results[o]->store(&b.out[o][static_cast<std::size_t>(e0)]);
   }
 
   // Wall contacts e0 and e1 in one pack, set up as Simulation::wall_contact does (e1 = e0 for
@@ -215,32 +261,33 @@ class ComposedModel final : public ContactModel {
   DEM_AVX_CLONES void wall_pack(const Particles& P, const MaterialTable& material,
                                 const ContactStep& step, const WallContact* contacts,
                                 std::size_t e0, bool two, ContactResult* results) const {
-    using V = Vec3T<Pack>;
+    using V = Vec3T<WallPack>;
     const WallContact& w0 = contacts[e0];
     const WallContact& w1 = contacts[two ? e0 + 1 : e0];
     const std::size_t i0 = w0.i, i1 = w1.i;
     auto pack3 = [](const Vec3& p0, const Vec3& p1) {
-      return V{Pack(p0.x, p1.x), Pack(p0.y, p1.y), Pack(p0.z, p1.z)};
+      return V{WallPack(p0.x, p1.x), WallPack(p0.y, p1.y), WallPack(p0.z, p1.z)};
     };
-    ContactInputT<Pack> c;
+    ContactInputT<WallPack> c;
     c.wall = true;
     c.n = pack3(w0.normal, w1.normal);
-    c.overlap = Pack(w0.overlap, w1.overlap);
-    c.dist = Pack(w0.dist, w1.dist);
-    c.ri = Pack(P.radius[i0], P.radius[i1]);
+    c.overlap = WallPack(w0.overlap, w1.overlap);
+    c.dist = WallPack(w0.dist, w1.dist);
+    c.ri = WallPack(P.radius[i0], P.radius[i1]);
     c.rj = 0.0;
     c.r_eff = c.ri;
-    c.m_eff = Pack(P.rmass[i0], P.rmass[i1]);
+    c.m_eff = WallPack(P.rmass[i0], P.rmass[i1]);
     c.cri = c.ri - 0.5 * c.overlap;
     c.crj = 0.0;
     c.v_rel = pack3(P.v[i0], P.v[i1]) - pack3(w0.wall_velocity, w1.wall_velocity);
     c.omega_i = pack3(P.omega[i0], P.omega[i1]);
-    c.omega_j = V{Pack(0.0), Pack(0.0), Pack(0.0)};
-    const PairParamsT<Pack> p = pack_params(material.get(P.type[i0], w0.wall_type),
-                                            material.get(P.type[i1], w1.wall_type));
-    Pack hist[kHistorySize];
-    for (int q = 0; q < kHistorySize; ++q) hist[q] = Pack(w0.history[q], w1.history[q]);
-    ContactResultT<Pack> res;
+    c.omega_j = V{WallPack(0.0), WallPack(0.0), WallPack(0.0)};
+    const PairParams* pair[kWallLanes] = {&material.get(P.type[i0], w0.wall_type),
+                                          &material.get(P.type[i1], w1.wall_type)};
+    const PairParamsT<WallPack> p = pack_params<WallPack>(pair);
+    WallPack hist[kHistorySize];
+    for (int q = 0; q < kHistorySize; ++q) hist[q] = WallPack(w0.history[q], w1.history[q]);
+    ContactResultT<WallPack> res;
     contact_law<Cohesion, Rolling>(c, p, step, hist, res);
     const int lanes = two ? 2 : 1;
     for (int l = 0; l < lanes; ++l) {
@@ -258,20 +305,10 @@ class ComposedModel final : public ContactModel {
     }
   }
 
-  static PairParamsT<Pack> pack_params(const PairParams& p0, const PairParams& p1) {
-    PairParamsT<Pack> p;
-    p.y_star = Pack(p0.y_star, p1.y_star);
-    p.g_star = Pack(p0.g_star, p1.g_star);
-    p.beta = Pack(p0.beta, p1.beta);
-    p.mu_s = Pack(p0.mu_s, p1.mu_s);
-    p.mu_r = Pack(p0.mu_r, p1.mu_r);
-    p.cohesion = Pack(p0.cohesion, p1.cohesion);
-    return p;
-  }
 
   // m_i m_j / (m_i + m_j); with fix freeze, a zero mass stands for a frozen particle and the
   // effective mass is the other one's.
-  static Pack m_effective(const Pack& mi, const Pack& mj, bool freeze) {
+  DEM_INLINE static Pack m_effective(const Pack& mi, const Pack& mj, bool freeze) {
     const Pack m_eff = mi * mj / (mi + mj);
     if (!freeze) return m_eff;
     return select(mi > 0.0 && mj > 0.0, m_eff, mi + mj);
@@ -289,11 +326,6 @@ class ComposedModel final : public ContactModel {
     double worst_ratio = 0.0;
     long worst_tag = -1;
     long contacts = 0;
-    const Vec3* x = P.x.data();
-    const double* rad = P.radius.data();
-    const int* first = a.list.first.data();
-    const int* partner = a.list.partner.data();
-    std::uint8_t* touching = a.list.touching.data();
     const int max_pairs = a.list.max_pairs_per_particle();
     // Per thread: one past the largest particle index it adds forces to.
     std::vector<std::size_t> touched_end(static_cast<std::size_t>(nthreads), 0);
@@ -305,6 +337,14 @@ class ComposedModel final : public ContactModel {
       // are summed in below: one thread needs neither buffers nor a reduction.
       const int tid = omp_get_thread_num();
       const int team = omp_get_num_threads();  // may be fewer than asked for
+      // Array pointers as locals of each thread, not shared variables of the parallel region:
+      // those are reached through memory, and the byte stores to `touching` may alias
+      // anything, so the compiler would reload each of them after every store.
+      const Vec3* const x = P.x.data();
+      const double* const rad = P.radius.data();
+      const int* const first = a.list.first.data();
+      const int* const partner = a.list.partner.data();
+      std::uint8_t* const touching = a.list.touching.data();
       const ParticleShare own = a.list.partition().share(n, tid, team);
       std::size_t end_j = own.end;
       for (std::size_t i = own.begin; i < own.end; ++i)
@@ -326,11 +366,10 @@ class ComposedModel final : public ContactModel {
       static thread_local Batch batch;
       batch.reserve(capacity);
       batch.size = 0;
-      batch.params_of[0] = batch.params_of[1] = nullptr;  // the material table may have changed
+      // The material table may have changed.
+      std::fill(std::begin(batch.params_of), std::end(batch.params_of), nullptr);
       double my_ratio = 0.0;
       long my_tag = -1;
-      // Raw pointers in locals: the byte stores to `touching` may alias anything, which would
-      // make the compiler reload every pointer held in memory after each of them.
       int* const bi = batch.i.data();
       int* const bj = batch.j.data();
       int* const bk = batch.k.data();
@@ -350,7 +389,7 @@ class ComposedModel final : public ContactModel {
       auto flush = [&]() {
         const int size = batch.size;
         for (int h = 0; h < size; h += kLanes)
-          contact_pack<Periodic>(a, step, batch, h, h + 1 < size);
+          contact_pack<Periodic>(a, step, batch, h, std::min(kLanes, size - h));
         // The sums on i stay in registers while its contacts follow one another (partners
         // have j > i, so no other contact of the batch adds to f[i] meanwhile).
         for (int h = 0; h < size;) {

@@ -5,7 +5,8 @@
 namespace dem {
 
 // The contact types and sub-models are written for a number type R: double (one contact), or
-// Pack2 (two contacts in lockstep, core/simd.h), which rounds lane by lane exactly as double.
+// Pack2 / Pack4 (two or four contacts in lockstep, core/simd.h), which round lane by lane
+// exactly as double.
 
 // Per type-pair material parameters, mixed once at set-up (PHYSICS.md section 3).
 template <class R>

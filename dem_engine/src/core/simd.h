@@ -114,6 +114,54 @@ inline Pack2 select(const Mask2& mask, const Pack2& a, const Pack2& b) {
 inline bool any(const Mask2& mask) { return lane_set(mask, 0) || lane_set(mask, 1); }
 #endif
 
+// Four doubles in lockstep, written on GCC's generic vectors: in the AVX copy of a function
+// (DEM_AVX_CLONES) each operation is one 256-bit instruction, in plain x86-64 two SSE2 ones.
+// Every operation rounds lane by lane as double does (as Pack2); the lane-wise sqrt below
+// compiles to one vector square root. Passed by value only inside inlined code, so the ABI
+// note GCC gives for 32-byte vectors without AVX (-Wpsabi) does not apply.
+struct Pack4 {
+  typedef double Raw __attribute__((vector_size(32)));
+  typedef std::int64_t Bits __attribute__((vector_size(32)));
+  Raw v;
+
+  Pack4() : v{0.0, 0.0, 0.0, 0.0} {}
+  Pack4(double s) : v{s, s, s, s} {}  // NOLINT: implicit broadcast, as for Pack2
+  Pack4(double a, double b, double c, double d) : v{a, b, c, d} {}
+  explicit Pack4(Raw r) : v(r) {}
+  double operator[](int lane) const { return v[lane]; }
+  void store(double* to) const { std::memcpy(to, &v, sizeof v); }
+  Pack4& operator+=(const Pack4& o) { v += o.v; return *this; }
+  Pack4& operator-=(const Pack4& o) { v -= o.v; return *this; }
+  Pack4& operator*=(const Pack4& o) { v *= o.v; return *this; }
+};
+
+// Lane mask of a Pack4 comparison: all bits set where it holds.
+struct Mask4 {
+  Pack4::Bits m;
+};
+
+inline Pack4 operator+(const Pack4& a, const Pack4& b) { return Pack4(a.v + b.v); }
+inline Pack4 operator-(const Pack4& a, const Pack4& b) { return Pack4(a.v - b.v); }
+inline Pack4 operator*(const Pack4& a, const Pack4& b) { return Pack4(a.v * b.v); }
+inline Pack4 operator/(const Pack4& a, const Pack4& b) { return Pack4(a.v / b.v); }
+inline Pack4 operator-(const Pack4& a) { return Pack4(-a.v); }
+inline Mask4 operator>(const Pack4& a, const Pack4& b) { return {a.v > b.v}; }
+inline Mask4 operator<(const Pack4& a, const Pack4& b) { return {a.v < b.v}; }
+inline Mask4 operator&&(const Mask4& a, const Mask4& b) { return {a.m & b.m}; }
+inline Pack4 lane_sqrt(const Pack4& a) {
+  return Pack4(std::sqrt(a.v[0]), std::sqrt(a.v[1]), std::sqrt(a.v[2]), std::sqrt(a.v[3]));
+}
+// |a|: clears the sign bits, exactly as std::fabs.
+inline Pack4 lane_abs(const Pack4& a) {
+  const Pack4::Bits magnitude = ~Pack4::Bits{INT64_MIN, INT64_MIN, INT64_MIN, INT64_MIN};
+  return Pack4(reinterpret_cast<Pack4::Raw>(reinterpret_cast<Pack4::Bits>(a.v) & magnitude));
+}
+// a where the mask is set, b elsewhere (exact copies).
+inline Pack4 select(const Mask4& mask, const Pack4& a, const Pack4& b) {
+  return Pack4(mask.m ? a.v : b.v);
+}
+inline bool any(const Mask4& mask) { return (mask.m[0] | mask.m[1] | mask.m[2] | mask.m[3]) != 0; }
+
 // The same operations on plain doubles, so that contact code can be written once for both.
 inline double lane_sqrt(double a) { return std::sqrt(a); }
 inline double lane_abs(double a) { return std::fabs(a); }
