@@ -256,7 +256,7 @@ class ComposedModel final : public ContactModel {
     for (int o = 0; o < 10; ++o) results[o]->store(&b.out[o][static_cast<std::size_t>(e0)]);
   }
 
-  // Wall contacts e0 and e1 in one pack, set up as Simulation::wall_contact does (e1 = e0 for
+  // Wall contacts e0 and e1 in one pack, set up as WallContact says (e1 = e0 for
   // a lone last contact, whose second lane is dropped).
   DEM_AVX_CLONES void wall_pack(const Particles& P, const MaterialTable& material,
                                 const ContactStep& step, const WallContact* contacts,

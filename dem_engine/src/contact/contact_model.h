@@ -50,7 +50,10 @@ struct PairForceArgs {
   long contacts = 0;               // out: touching pairs
 };
 
-// One contact of particle i with a wall (what Simulation::wall_contact takes).
+// One contact of particle i with a wall or mesh surface (walls reuse the pair model). Its law
+// sees the wall as a partner of radius 0 and infinite mass: R* = r_i, m* = m_i, lever arm
+// r_i - overlap / 2 (as for particle pairs, LIGGGHTS), relative velocity v_i - wall_velocity,
+// the wall not rotating.
 struct WallContact {
   std::size_t i = 0;
   Vec3 normal;  // unit normal from the wall towards the particle centre
@@ -70,8 +73,8 @@ class ContactModel {
   // One contact: updates history (kHistorySize doubles) and fills result.
   virtual void evaluate(const ContactInput& c, const PairParams& p, const ContactStep& step,
                         double* history, ContactResult& result) const = 0;
-  // Many wall contacts at once: results[k] is what Simulation::wall_contact gives for
-  // contacts[k], bit for bit.
+  // Many wall contacts at once (see WallContact): results[k] is the law of contacts[k], bit
+  // for bit as evaluate() gives it one contact at a time.
   virtual void wall_forces(const Particles& atoms, const MaterialTable& material,
                            const ContactStep& step, const WallContact* contacts, std::size_t count,
                            ContactResult* results) const = 0;

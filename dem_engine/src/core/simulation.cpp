@@ -86,26 +86,6 @@ const ContactModel& Simulation::pair_model() const {
   return *pair;
 }
 
-void Simulation::wall_contact(std::size_t i, const Vec3& normal, double overlap, double dist,
-                              const Vec3& wall_velocity, int wall_type, double* history,
-                              ContactResult& result) const {
-  ContactInput c;
-  c.wall = true;
-  c.n = normal;
-  c.overlap = overlap;
-  c.dist = dist;
-  c.ri = atoms.radius[i];
-  c.rj = 0.0;
-  c.r_eff = c.ri;
-  c.m_eff = atoms.rmass[i];
-  c.cri = c.ri - 0.5 * overlap;  // as for particle pairs (LIGGGHTS)
-  c.crj = 0.0;
-  c.v_rel = atoms.v[i] - wall_velocity;
-  c.omega_i = atoms.omega[i];
-  c.omega_j = Vec3{};
-  pair_model().evaluate(c, material.get(atoms.type[i], wall_type), wall_step(), history, result);
-}
-
 ContactStep Simulation::wall_step() const {
   ContactStep step;
   step.options = pair_model().spec().options;

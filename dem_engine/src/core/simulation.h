@@ -81,11 +81,6 @@ class Simulation : public CommandHandler, public EvalContext {
   void note_deep_overlap(double ratio, long tag, const std::string& partner);
   std::ofstream* log_stream() { return log_.is_open() ? &log_ : nullptr; }
   Input& input() { return *input_; }
-  // Evaluates a contact between particle i and a wall/mesh surface (walls reuse the pair model).
-  // `wall_type` is the atom type of the wall material; `history` holds kHistorySize doubles.
-  void wall_contact(std::size_t i, const Vec3& normal, double overlap, double dist,
-                    const Vec3& wall_velocity, int wall_type, double* history,
-                    ContactResult& result) const;
   // The step settings of a wall contact: the pair model's options, dt, and whether the
   // history advances (not while a run computes its initial forces).
   ContactStep wall_step() const;

@@ -33,8 +33,9 @@ std::string describe(const ModelSpec& s) {
 
 // Contacts of one particle that are evaluated (beyond any plausible packing).
 constexpr std::size_t kMaxContacts = 64;
-// Primitive-wall contacts whose laws are run together.
+// Wall contacts whose laws are run together.
 constexpr std::size_t kWallChunk = 64;
+static_assert(kMaxContacts <= kWallChunk, "one particle's mesh contacts fit in one chunk");
 // Below this many particles a parallel region costs more than it saves.
 constexpr std::size_t kParallelMin = 4096;
 
@@ -263,6 +264,8 @@ void FixWallGran::mesh_forces() {
     std::fill(s.force.begin(), s.force.end(), Vec3{});
     std::fill(s.torque.begin(), s.torque.end(), Vec3{});
   }
+  const ContactModel& model = sim_.pair_model();
+  const ContactStep step = sim_.wall_step();
 #pragma omp parallel num_threads(nthreads) if (n >= kParallelMin) reduction(+ : overflow)
   {
     Scratch& s = scratch_[omp_get_thread_num()];
@@ -270,6 +273,34 @@ void FixWallGran::mesh_forces() {
     long my_tag = -1;
     const ParticleShare own =
         sim_.neighbor.partition().share(n, omp_get_thread_num(), omp_get_num_threads());
+    // Contacts are collected over particles in chunks and their laws run together
+    // (ContactModel::wall_forces, as for primitive walls); their forces are then added in the
+    // order the contacts were found, so every sum is that of one contact at a time.
+    WallContact chunk[kWallChunk];
+    ContactResult results[kWallChunk];
+    std::uint32_t chunk_mesh[kWallChunk];
+    Vec3 chunk_point[kWallChunk];
+    std::size_t count = 0;
+    auto flush = [&]() {
+      model.wall_forces(P, sim_.material, step, chunk, count, results);
+      for (std::size_t k = 0; k < count; ++k) {
+        const std::size_t i = chunk[k].i;
+        const ContactResult& res = results[k];
+        const std::uint32_t m = chunk_mesh[k];
+        P.f[i] += res.force;
+        P.torque[i] += res.torque_i;
+        if (P.mask[i] & stress_bits[m]) {
+          s.force[m] -= res.force;
+          s.torque[m] -= cross(chunk_point[k] - ref[m], res.force);
+        }
+        const double overlap = chunk[k].overlap;
+        if (overlap > my_worst * P.radius[i]) {
+          my_worst = overlap / P.radius[i];
+          my_tag = static_cast<long>(P.tag[i]);
+        }
+      }
+      count = 0;
+    };
     for (std::size_t i = own.begin; i < own.end; ++i) {
       double* slots = slots_all + i * kMeshSlots * kMeshSlotWidth;
       s.contacts.clear();
@@ -284,28 +315,30 @@ void FixWallGran::mesh_forces() {
         continue;
       }
       if (s.contacts.size() > kMaxContacts) s.contacts.resize(kMaxContacts);
-      overflow += assign_history_slots(slots, s.contacts, meshes_, s.history,
-                                       s.overflow.data());
+      const int unkept =
+          assign_history_slots(slots, s.contacts, meshes_, s.history, s.overflow.data());
+      overflow += unkept;
+      if (count + s.contacts.size() > kWallChunk) flush();
       for (std::size_t k = 0; k < s.contacts.size(); ++k) {
         const MeshContact& c = s.contacts[k];
         const TriMesh& mesh = *meshes_[c.mesh];
-        const Vec3 v_wall = mesh.moving() ? mesh.velocity_at(c.tri, c.cp) : Vec3{};
-        const double overlap = P.radius[i] - c.dist;
-        ContactResult res;
-        sim_.wall_contact(i, c.normal, overlap, c.dist, v_wall, mesh_fixes_[c.mesh]->wall_type(),
-                          s.history[k], res);
-        P.f[i] += res.force;
-        P.torque[i] += res.torque_i;
-        if (P.mask[i] & stress_bits[c.mesh]) {
-          s.force[c.mesh] -= res.force;
-          s.torque[c.mesh] -= cross(c.cp.point - ref[c.mesh], res.force);
-        }
-        if (overlap > my_worst * P.radius[i]) {
-          my_worst = overlap / P.radius[i];
-          my_tag = static_cast<long>(P.tag[i]);
-        }
+        WallContact& w = chunk[count];
+        w.i = i;
+        w.normal = c.normal;
+        w.overlap = P.radius[i] - c.dist;
+        w.dist = c.dist;
+        w.wall_velocity = mesh.moving() ? mesh.velocity_at(c.tri, c.cp) : Vec3{};
+        w.wall_type = mesh_fixes_[c.mesh]->wall_type();
+        w.history = s.history[k];
+        chunk_mesh[count] = c.mesh;
+        chunk_point[count] = c.cp.point;
+        ++count;
       }
+      // Contacts past the slots keep their history in the thread's overflow buffer, which
+      // the next particle reuses.
+      if (unkept > 0) flush();
     }
+    flush();
 #pragma omp critical
     if (my_worst > worst || (my_worst == worst && my_tag >= 0 && my_tag < worst_tag)) {
       worst = my_worst;
