@@ -39,6 +39,22 @@ static_assert(kMaxContacts <= kWallChunk, "one particle's mesh contacts fit in o
 // Below this many particles a parallel region costs more than it saves.
 constexpr std::size_t kParallelMin = 4096;
 
+// Adds the forces and torques of a chunk of wall contacts to their particles, in chunk order,
+// and keeps the deepest overlap relative to the radius and its particle's tag.
+void add_wall_results(Particles& P, const WallContact* chunk, const ContactResult* results,
+                      std::size_t count, double& worst, long& worst_tag) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t i = chunk[k].i;
+    P.f[i] += results[k].force;
+    P.torque[i] += results[k].torque_i;
+    const double overlap = chunk[k].overlap;
+    if (overlap > worst * P.radius[i]) {
+      worst = overlap / P.radius[i];
+      worst_tag = static_cast<long>(P.tag[i]);
+    }
+  }
+}
+
 }  // namespace
 
 FixWallGran::FixWallGran(Simulation& sim, const Command& command) : Fix(sim, command) {
@@ -200,16 +216,7 @@ void FixWallGran::primitive_forces() {
     std::size_t count = 0;
     auto flush = [&]() {
       model.wall_forces(P, sim_.material, step, chunk, count, results);
-      for (std::size_t k = 0; k < count; ++k) {
-        const std::size_t i = chunk[k].i;
-        P.f[i] += results[k].force;
-        P.torque[i] += results[k].torque_i;
-        const double overlap = chunk[k].overlap;
-        if (overlap > my_worst * P.radius[i]) {
-          my_worst = overlap / P.radius[i];
-          my_tag = static_cast<long>(P.tag[i]);
-        }
-      }
+      add_wall_results(P, chunk, results, count, my_worst, my_tag);
       count = 0;
     };
     for (auto it = from; it != to; ++it) {
@@ -283,20 +290,12 @@ void FixWallGran::mesh_forces() {
     std::size_t count = 0;
     auto flush = [&]() {
       model.wall_forces(P, sim_.material, step, chunk, count, results);
+      add_wall_results(P, chunk, results, count, my_worst, my_tag);
       for (std::size_t k = 0; k < count; ++k) {
-        const std::size_t i = chunk[k].i;
-        const ContactResult& res = results[k];
         const std::uint32_t m = chunk_mesh[k];
-        P.f[i] += res.force;
-        P.torque[i] += res.torque_i;
-        if (P.mask[i] & stress_bits[m]) {
-          s.force[m] -= res.force;
-          s.torque[m] -= cross(chunk_point[k] - ref[m], res.force);
-        }
-        const double overlap = chunk[k].overlap;
-        if (overlap > my_worst * P.radius[i]) {
-          my_worst = overlap / P.radius[i];
-          my_tag = static_cast<long>(P.tag[i]);
+        if (P.mask[chunk[k].i] & stress_bits[m]) {
+          s.force[m] -= results[k].force;
+          s.torque[m] -= cross(chunk_point[k] - ref[m], results[k].force);
         }
       }
       count = 0;
