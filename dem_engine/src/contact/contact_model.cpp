@@ -195,9 +195,8 @@ class ComposedModel final : public ContactModel {
     if constexpr (Periodic) {
       Vec3 dl[kLanes];
       for (int l = 0; l < kLanes; ++l) dl[l] = a.domain.minimum_image(x[ii[l]] - x[jj[l]]);
-      d = V{lanes_of<Pack>([&](int l) { return dl[l].x; }),
-            lanes_of<Pack>([&](int l) { return dl[l].y; }),
-            lanes_of<Pack>([&](int l) { return dl[l].z; })};
+      const std::size_t lane[kLanes] = {0, 1, 2, 3};
+      d = pack3(dl, lane);
     } else {
       d = pack3(x, ii) - pack3(x, jj);
     }
@@ -215,7 +214,7 @@ class ComposedModel final : public ContactModel {
       for (int l = 0; l < kLanes; ++l) {
         m[l][0] = mass[ii[l]];
         m[l][1] = mass[jj[l]];
-        if (P.mask[ii[l]] & a.freeze_bit) m[l][0] = 0.0, m[l][1] = mass[jj[l]];
+        if (P.mask[ii[l]] & a.freeze_bit) m[l][0] = 0.0;
         if (P.mask[jj[l]] & a.freeze_bit) m[l][0] = mass[ii[l]], m[l][1] = 0.0;
       }
       mi = lanes_of<Pack>([&](int l) { return m[l][0]; });
@@ -304,7 +303,6 @@ class ComposedModel final : public ContactModel {
       r.torque_j = Vec3{res.torque_j.x[l], res.torque_j.y[l], res.torque_j.z[l]};
     }
   }
-
 
   // m_i m_j / (m_i + m_j); with fix freeze, a zero mass stands for a frozen particle and the
   // effective mass is the other one's.
