@@ -138,22 +138,16 @@ class ComposedModel final : public ContactModel {
   using WallPack = Pack2;
   static constexpr int kWallLanes = 2;
   static constexpr int kBatch = 128;  // contacts per batch: its buffers stay in L1
+  // Entries per batch buffer: the spare ones past kBatch take the dropped lanes of the last
+  // pack. A fixed stride lets one register address every result column.
+  static constexpr int kStride = kBatch + kLanes;
 
   // Touching pairs waiting for their contact law: particle i, its partner j, the list entry k,
   // and the results (force on i, torque on i, torque on j, overlap), one array per component
-  // so that a pack of results is stored at once.
+  // so that a pack of results is stored at once. Kept per thread between steps.
   struct Batch {
-    // Kept per thread between steps (no allocations per step once large enough).
-    void reserve(int capacity) {
-      const auto size = static_cast<std::size_t>(capacity) + kLanes;
-      if (i.size() >= size) return;
-      i.resize(size);
-      j.resize(size);
-      k.resize(size);
-      for (auto& o : out) o.resize(size);
-    }
-    std::vector<int> i, j, k;
-    std::array<std::vector<double>, 10> out;
+    int i[kStride], j[kStride], k[kStride];
+    alignas(32) double out[10][kStride];
     int size = 0;
     // The material parameters of the last pack, reused while the type pairs repeat (always,
     // with one particle type).
@@ -247,12 +241,18 @@ class ComposedModel final : public ContactModel {
     contact_law<Cohesion, Rolling>(c, p, step, hist, res);
     for (int l = 0; l < count; ++l)
       for (int q6 = 0; q6 < kHistorySize; ++q6) h[l][q6] = hist[q6][l];
-    // Whole packs are stored; dropped lanes land in the spare entries past the batch.
-    const Pack* results[10] = {&res.force.x,    &res.force.y,    &res.force.z,
-                               &res.torque_i.x, &res.torque_i.y, &res.torque_i.z,
-                               &res.torque_j.x, &res.torque_j.y, &res.torque_j.z,
-                               &c.overlap};
-    for (int o = 0; o < 10; ++o) results[o]->store(&b.out[o][static_cast<std::size_t>(e0)]);
+    // Whole packs are stored; dropped lanes land in the spare entries past the batch. (Named
+    // one by one: taking the results' addresses would keep them in memory.)
+    res.force.x.store(&b.out[0][e0]);
+    res.force.y.store(&b.out[1][e0]);
+    res.force.z.store(&b.out[2][e0]);
+    res.torque_i.x.store(&b.out[3][e0]);
+    res.torque_i.y.store(&b.out[4][e0]);
+    res.torque_i.z.store(&b.out[5][e0]);
+    res.torque_j.x.store(&b.out[6][e0]);
+    res.torque_j.y.store(&b.out[7][e0]);
+    res.torque_j.z.store(&b.out[8][e0]);
+    c.overlap.store(&b.out[9][e0]);
   }
 
   // Wall contacts e0 and e1 in one pack, set up as WallContact says (e1 = e0 for
@@ -324,7 +324,6 @@ class ComposedModel final : public ContactModel {
     double worst_ratio = 0.0;
     long worst_tag = -1;
     long contacts = 0;
-    const int max_pairs = a.list.max_pairs_per_particle();
     // Per thread: one past the largest particle index it adds forces to.
     std::vector<std::size_t> touched_end(static_cast<std::size_t>(nthreads), 0);
 #pragma omp parallel num_threads(nthreads) reduction(+ : contacts)
@@ -360,29 +359,16 @@ class ComposedModel final : public ContactModel {
       // Contacts are gathered across particles into batches (pass 1), whose contact laws run
       // kLanes contacts at a time on packs (pass 2); their forces are then added in the order
       // of the list (pass 3), so the sums are those of one contact at a time.
-      const int capacity = std::max(kBatch, max_pairs);
       static thread_local Batch batch;
-      batch.reserve(capacity);
       batch.size = 0;
       // The material table may have changed.
       std::fill(std::begin(batch.params_of), std::end(batch.params_of), nullptr);
       double my_ratio = 0.0;
       long my_tag = -1;
-      int* const bi = batch.i.data();
-      int* const bj = batch.j.data();
-      int* const bk = batch.k.data();
-      const double* out[10];
-      for (int q = 0; q < 10; ++q) out[q] = batch.out[static_cast<std::size_t>(q)].data();
-      const double* const fx = out[0];
-      const double* const fy = out[1];
-      const double* const fz = out[2];
-      const double* const tix = out[3];
-      const double* const tiy = out[4];
-      const double* const tiz = out[5];
-      const double* const tjx = out[6];
-      const double* const tjy = out[7];
-      const double* const tjz = out[8];
-      const double* const ov = out[9];
+      int* const bi = batch.i;
+      int* const bj = batch.j;
+      int* const bk = batch.k;
+      const auto& out = batch.out;
       const std::int64_t* const tag = P.tag.data();
       auto flush = [&]() {
         const int size = batch.size;
@@ -396,15 +382,15 @@ class ComposedModel final : public ContactModel {
           const double ri = rad[i];
           for (; h < size && bi[h] == i; ++h) {
             const int j = bj[h];
-            touching[bk[h]] = 1;
-            const Vec3 force{fx[h], fy[h], fz[h]};
+            const Vec3 force{out[0][h], out[1][h], out[2][h]};
             fi += force;
             f[j] -= force;
-            ti += Vec3{tix[h], tiy[h], tiz[h]};
-            t[j] += Vec3{tjx[h], tjy[h], tjz[h]};
+            ti += Vec3{out[3][h], out[4][h], out[5][h]};
+            t[j] += Vec3{out[6][h], out[7][h], out[8][h]};
             const double rmin = std::min(ri, rad[j]);
-            if (ov[h] > my_ratio * rmin) {
-              my_ratio = ov[h] / rmin;
+            const double overlap = out[9][h];
+            if (overlap > my_ratio * rmin) {
+              my_ratio = overlap / rmin;
               my_tag = tag[i];
             }
           }
@@ -415,31 +401,37 @@ class ComposedModel final : public ContactModel {
       };
 #pragma omp barrier
       for (std::size_t i = own.begin; i < own.end; ++i) {
+        int k = first[i];
         const int k_end = first[i + 1];
-        if (first[i] == k_end) continue;
-        if (batch.size + (k_end - first[i]) > capacity) flush();
+        if (k == k_end) continue;
         const Vec3 xi = x[i];
         const double ri = rad[i];
-        // Pass 1 sorts the listed pairs into touching ones and flags contacts that opened,
-        // without branching on the coin-flip condition. As in LIGGGHTS, the history of a pair
-        // that opened is kept while the pair stays in the list (a contact that closes again
-        // before the next neighbour build resumes it); the build drops it unless the pair
-        // touches at the build's positions (see NeighborList::build).
-        int m = batch.size;
-        for (int k = first[i]; k < k_end; ++k) {
-          const int j = partner[k];
-          Vec3 d = xi - x[j];
-          if constexpr (Periodic) d = a.domain.minimum_image(d);
-          const double radsum = ri + rad[j];
-          const bool apart = norm2(d) >= radsum * radsum;
-          bi[m] = static_cast<int>(i);
-          bj[m] = j;
-          bk[m] = k;
-          m += !apart;
-          touching[k] &= static_cast<std::uint8_t>(!apart);
+        // Pass 1 sorts the listed pairs into touching ones and flags which touch (every one
+        // gathered here gets its contact law), without branching on the coin-flip condition.
+        // As in LIGGGHTS, the history of a pair that opened is kept while the pair stays in
+        // the list (a contact that closes again before the next neighbour build resumes it);
+        // the build drops it unless the pair touches at the build's positions (see
+        // NeighborList::build). A full batch is flushed, also between the pairs of one
+        // particle: its sums continue in the same order.
+        while (k < k_end) {
+          if (batch.size == kBatch) flush();
+          const int stop = std::min(k_end, k + (kBatch - batch.size));
+          int m = batch.size;
+          for (; k < stop; ++k) {
+            const int j = partner[k];
+            Vec3 d = xi - x[j];
+            if constexpr (Periodic) d = a.domain.minimum_image(d);
+            const double radsum = ri + rad[j];
+            const bool apart = norm2(d) >= radsum * radsum;
+            bi[m] = static_cast<int>(i);
+            bj[m] = j;
+            bk[m] = k;
+            m += !apart;
+            touching[k] = static_cast<std::uint8_t>(!apart);
+          }
+          contacts += m - batch.size;
+          batch.size = m;
         }
-        contacts += m - batch.size;
-        batch.size = m;
       }
       flush();
 #pragma omp critical

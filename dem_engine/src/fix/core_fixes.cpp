@@ -57,9 +57,15 @@ class FixGravity : public Fix {
   void post_force() override {
     auto& P = sim_.atoms;
     const std::uint32_t bit = group_bit();
-    sim_.neighbor.partition().for_each(P.size(), [&](std::size_t begin, std::size_t end) {
+    // Locals of the lambda: a store to a force could alias accel_, reloaded after each one.
+    const std::uint32_t* const mask = P.mask.data();
+    const double* const mass = P.rmass.data();
+    Vec3* const f = P.f.data();
+    sim_.neighbor.partition().for_each(P.size(), [mask, mass, f, bit, g = accel_](
+                                                     std::size_t begin, std::size_t end) {
+      const Vec3 a = g;
       for (std::size_t i = begin; i < end; ++i)
-        if (P.mask[i] & bit) P.f[i] += P.rmass[i] * accel_;
+        if (mask[i] & bit) f[i] += mass[i] * a;
     });
   }
   const Vec3& acceleration() const { return accel_; }
@@ -83,16 +89,36 @@ class FixNveSphere : public Fix {
     const double dt = sim_.dt, half = 0.5 * dt;
     const std::uint32_t bit = group_bit();
     update_inverses();
-    const double* inv_m = inv_m_.data();
-    const double* inv_i = inv_i_.data();
-    sim_.neighbor.partition().for_each(P.size(), [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        if (!(P.mask[i] & bit)) continue;
-        P.v[i] += (half * inv_m[i]) * P.f[i];
-        P.omega[i] += (half * inv_i[i]) * P.torque[i];
-        if (drift) P.x[i] += dt * P.v[i];
-      }
+    // Everything the loop reads as locals of the lambda: a store to a velocity could alias
+    // any double reached through a reference, which would be reloaded after every store.
+    const Arrays a{P.mask.data(), inv_m_.data(), inv_i_.data(), P.f.data(), P.torque.data(),
+                   P.v.data(), P.omega.data(), P.x.data()};
+    sim_.neighbor.partition().for_each(P.size(), [a, bit, dt, half, drift](std::size_t begin,
+                                                                           std::size_t end) {
+      const double h = half, step = dt;
+      if (drift) move<true>(a, bit, step, h, begin, end);
+      else move<false>(a, bit, step, h, begin, end);
     });
+  }
+
+  struct Arrays {
+    const std::uint32_t* mask;
+    const double *inv_m, *inv_i;
+    const Vec3 *f, *torque;
+    Vec3 *v, *omega, *x;
+  };
+
+  // Velocity Verlet half kick of particles begin .. end - 1 in the group `bit`, and with Drift
+  // the full-step drift of their positions.
+  template <bool Drift>
+  static void move(Arrays a, std::uint32_t bit, double dt, double half, std::size_t begin,
+                   std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (!(a.mask[i] & bit)) continue;
+      a.v[i] += (half * a.inv_m[i]) * a.f[i];
+      a.omega[i] += (half * a.inv_i[i]) * a.torque[i];
+      if constexpr (Drift) a.x[i] += dt * a.v[i];
+    }
   }
 
   // Inverse masses and inertias, recomputed only when particles or their masses change, not
