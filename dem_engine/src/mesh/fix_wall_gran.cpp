@@ -253,6 +253,8 @@ void FixWallGran::mesh_forces() {
   const std::size_t n = P.size();
   const std::uint32_t bit = group_bit();
   if (list_.due(P, meshes_)) list_.build(P, bit, meshes_, sim_.neighbor.skin);
+  const bool same_list = slots_checked_for_build_ == list_.builds();
+  slots_checked_for_build_ = list_.builds();
   const std::size_t nm = meshes_.size();
   std::vector<std::uint32_t>& stress_bits = stress_bits_;
   std::vector<Vec3>& ref = reference_;
@@ -301,11 +303,12 @@ void FixWallGran::mesh_forces() {
       count = 0;
     };
     for (std::size_t i = own.begin; i < own.end; ++i) {
+      const int candidates = first[i + 1] - first[i];
+      if (candidates == 0 && same_list) continue;
       double* slots = slots_all + i * kMeshSlots * kMeshSlotWidth;
       s.contacts.clear();
       if (P.mask[i] & bit)
-        find_mesh_contacts(P.x[i], P.radius[i], refs + first[i], first[i + 1] - first[i], meshes_,
-                           s.contacts);
+        find_mesh_contacts(P.x[i], P.radius[i], refs + first[i], candidates, meshes_, s.contacts);
       if (s.contacts.empty()) {
         // Release the slots of contacts that opened.
         for (int k = 0; k < kMeshSlots; ++k)

@@ -54,6 +54,9 @@ class FixWallGran : public Fix {
   std::vector<FixMeshSurface*> mesh_fixes_;  // refreshed at every init
   std::vector<const TriMesh*> meshes_;
   TriangleNeighborList list_;
+  // The build of list_ the last step ran with: while it stays the same, a particle without
+  // candidate triangles had none at that step either, so its history slots are already free.
+  long slots_checked_for_build_ = -1;
   std::vector<std::uint32_t> stress_bits_;  // per mesh: group bit if it tracks stress, else 0
   std::vector<Vec3> reference_;             // per mesh: torque reference point
   std::size_t history_ = 0;                 // Particles extra handle

@@ -93,54 +93,6 @@ TrianglePlane triangle_plane(const Vec3& a, const Vec3& b, const Vec3& c) {
   return t;
 }
 
-ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
-                                       const Vec3& c, const TrianglePlane& plane,
-                                       double tolerance) {
-  ClosestPoint r;
-  r.point = a;
-  if (!(plane.area2 > 0.0)) return r;
-  const double w[3] = {dot(p - b, plane.grad[0]), dot(p - c, plane.grad[1]),
-                       dot(p - a, plane.grad[2])};
-  const Vec3* v[3] = {&a, &b, &c};
-  const double lim = -tolerance;
-  const int negative = (w[0] < lim) + (w[1] < lim) + (w[2] < lim);
-  if (negative == 0) {
-    r.point = p - (dot(p - a, plane.n) / plane.area2) * plane.n;  // projection onto the plane
-    r.wa = w[0];
-    r.wb = w[1];
-    r.wc = w[2];
-    r.region = TriRegion::kFace;
-    return r;
-  }
-  if (negative == 1) {
-    // Edge opposite the negative coordinate, from node (k + 1) % 3 to node (k + 2) % 3.
-    const int k = w[0] < lim ? 0 : (w[1] < lim ? 1 : 2);
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
-    const Vec3 e = *v[j] - *v[i];
-    const double t = std::clamp(dot(p - *v[i], e) / norm2(e), 0.0, 1.0);
-    r.point = *v[i] + t * e;
-    double wt[3] = {0.0, 0.0, 0.0};
-    wt[i] = 1.0 - t;
-    wt[j] = t;
-    r.wa = wt[0];
-    r.wb = wt[1];
-    r.wc = wt[2];
-    static constexpr TriRegion kEdgeFrom[3] = {TriRegion::kEdgeAB, TriRegion::kEdgeBC,
-                                              TriRegion::kEdgeCA};
-    r.region = kEdgeFrom[i];
-    return r;
-  }
-  const int k = w[0] >= lim ? 0 : (w[1] >= lim ? 1 : 2);
-  static constexpr TriRegion kVertex[3] = {TriRegion::kVertexA, TriRegion::kVertexB,
-                                           TriRegion::kVertexC};
-  r.point = *v[k];
-  r.wa = k == 0 ? 1.0 : 0.0;
-  r.wb = k == 1 ? 1.0 : 0.0;
-  r.wc = k == 2 ? 1.0 : 0.0;
-  r.region = kVertex[k];
-  return r;
-}
-
 Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 n = cross(b - a, c - a);
   const double len = norm(n);

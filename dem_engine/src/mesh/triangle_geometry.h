@@ -1,4 +1,6 @@
 #pragma once
+#include <algorithm>
+
 #include "core/vec3.h"
 
 namespace dem {
@@ -46,8 +48,54 @@ TrianglePlane triangle_plane(const Vec3& a, const Vec3& b, const Vec3& c);
 // remaining vertex. Differs from closest_point_on_triangle in the region reported, at obtuse
 // angles in the point, and within the tolerance of an edge. Degenerate triangles give their
 // first vertex. `plane` is triangle_plane(a, b, c), computed beforehand.
-ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
-                                       const TrianglePlane& plane, double tolerance);
+// Inline: the mesh contact search calls it for every candidate triangle near its plane.
+inline ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                              const Vec3& c, const TrianglePlane& plane,
+                                              double tolerance) {
+  ClosestPoint r;
+  r.point = a;
+  if (!(plane.area2 > 0.0)) return r;
+  const double w[3] = {dot(p - b, plane.grad[0]), dot(p - c, plane.grad[1]),
+                       dot(p - a, plane.grad[2])};
+  const Vec3* v[3] = {&a, &b, &c};
+  const double lim = -tolerance;
+  const int negative = (w[0] < lim) + (w[1] < lim) + (w[2] < lim);
+  if (negative == 0) {
+    r.point = p - (dot(p - a, plane.n) / plane.area2) * plane.n;  // projection onto the plane
+    r.wa = w[0];
+    r.wb = w[1];
+    r.wc = w[2];
+    r.region = TriRegion::kFace;
+    return r;
+  }
+  if (negative == 1) {
+    // Edge opposite the negative coordinate, from node (k + 1) % 3 to node (k + 2) % 3.
+    const int k = w[0] < lim ? 0 : (w[1] < lim ? 1 : 2);
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    const Vec3 e = *v[j] - *v[i];
+    const double t = std::clamp(dot(p - *v[i], e) / norm2(e), 0.0, 1.0);
+    r.point = *v[i] + t * e;
+    // Weight 1 - t at node i, t at node j (not through an array indexed by i and j: its
+    // element-wise stores and whole reads would stall the store forwarding).
+    auto weight = [&](int node) { return node == i ? 1.0 - t : (node == j ? t : 0.0); };
+    r.wa = weight(0);
+    r.wb = weight(1);
+    r.wc = weight(2);
+    static constexpr TriRegion kEdgeFrom[3] = {TriRegion::kEdgeAB, TriRegion::kEdgeBC,
+                                              TriRegion::kEdgeCA};
+    r.region = kEdgeFrom[i];
+    return r;
+  }
+  const int k = w[0] >= lim ? 0 : (w[1] >= lim ? 1 : 2);
+  static constexpr TriRegion kVertex[3] = {TriRegion::kVertexA, TriRegion::kVertexB,
+                                           TriRegion::kVertexC};
+  r.point = *v[k];
+  r.wa = k == 0 ? 1.0 : 0.0;
+  r.wb = k == 1 ? 1.0 : 0.0;
+  r.wc = k == 2 ? 1.0 : 0.0;
+  r.region = kVertex[k];
+  return r;
+}
 
 // Unit normal (b - a) x (c - a) / |...|; the zero vector for a degenerate triangle.
 Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
