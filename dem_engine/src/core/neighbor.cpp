@@ -136,7 +136,6 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   forced_ = false;
   ++builds_;
   if (n == 0) {
-    max_pairs_ = 0;
     mark_touching(p, domain, 1);
     return;
   }
@@ -283,11 +282,7 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
       }
     }
   }
-  max_pairs_ = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    first[i + 1] = first[i] + static_cast<int>(found_[i].size());
-    max_pairs_ = std::max(max_pairs_, first[i + 1] - first[i]);
-  }
+  for (std::size_t i = 0; i < n; ++i) first[i + 1] = first[i] + static_cast<int>(found_[i].size());
   partner.resize(static_cast<std::size_t>(first[n]));
   history.assign(partner.size() * kHistorySize, 0.0);
   const long ln = static_cast<long>(n);

@@ -49,7 +49,6 @@ class NeighborList {
   // The split of the particles between threads, balanced by contacts at every build.
   const ParticlePartition& partition() const { return partition_; }
   std::size_t pairs() const { return partner.size(); }
-  int max_pairs_per_particle() const { return max_pairs_; }
 
  private:
   // Sets `touching` from the positions of the build, drops the histories of the pairs apart
@@ -64,7 +63,6 @@ class NeighborList {
   std::vector<double> bin_r_;            // radii in bin order (build scratch)
   bool forced_ = true;
   long builds_ = 0;
-  int max_pairs_ = 0;
 };
 
 }  // namespace dem
