@@ -75,12 +75,12 @@ void find_mesh_contacts(const Vec3& x, double r, const TriRef* refs, int n,
 int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
                          const std::vector<const TriMesh*>& meshes, std::vector<double*>& history,
                          double* overflow) {
-  // The slots as the previous step left them.
-  double before[kMeshSlots * kMeshSlotWidth];
-  std::copy(slots, slots + kMeshSlots * kMeshSlotWidth, before);
+  // The keys as the previous step left them (step 1 writes no slot).
+  double keys[kMeshSlots];
+  for (int s = 0; s < kMeshSlots; ++s) keys[s] = slots[s * kMeshSlotWidth];
   auto previous_slot = [&](double key) {
     for (int s = 0; s < kMeshSlots; ++s)
-      if (before[s * kMeshSlotWidth] == key) return s;
+      if (keys[s] == key) return s;
     return -1;
   };
   // 1. Which contacts act, in order; persisting ones keep their slot.
@@ -109,6 +109,11 @@ int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
   //    coplanar neighbour triangle if there is one.
   auto slot = [&](int s) { return slots + s * kMeshSlotWidth; };
   int overflowed = 0;
+  // The slots as the previous step left them, kept only when a new contact may copy from one
+  // (the slot it copies from can be given to another new contact below).
+  double before[kMeshSlots * kMeshSlotWidth];
+  if (std::any_of(kept_slot.begin(), kept_slot.end(), [](int s) { return s < 0; }))
+    std::copy(slots, slots + kMeshSlots * kMeshSlotWidth, before);
   for (std::size_t c = 0; c < acting; ++c) {
     if (kept_slot[c] >= 0) {
       history[c] = slot(kept_slot[c]) + 1;
@@ -117,7 +122,7 @@ int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
     const MeshContact& mc = contacts[c];
     const double* source = nullptr;
     for (int s = 0; s < kMeshSlots && !source; ++s) {
-      const double key = before[s * kMeshSlotWidth];
+      const double key = keys[s];
       if (key == 0.0 || mesh_of_key(key) != mc.mesh) continue;
       const std::uint32_t tri = tri_of_key(key);
       if (tri != mc.tri && meshes[mc.mesh]->topology().coplanar_neighbours(tri, mc.tri))
@@ -141,9 +146,9 @@ int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
     else std::fill(h, h + kHistorySize, 0.0);
     history[c] = h;
   }
-  // 3. Release the slots of contacts that opened.
+  // 3. Release the slots of contacts that opened (a free slot, key 0, is all zeros already).
   for (int s = 0; s < kMeshSlots; ++s)
-    if (!used[s]) std::fill(slot(s), slot(s) + kMeshSlotWidth, 0.0);
+    if (!used[s] && slot(s)[0] != 0.0) std::fill(slot(s), slot(s) + kMeshSlotWidth, 0.0);
   return overflowed;
 }
 
