@@ -101,10 +101,11 @@ void TriMesh::translate(const Vec3& d, std::size_t first_frame) {
 
 void TriMesh::rotate(const Vec3& unit_axis, double angle, const Vec3& center,
                      std::size_t first_frame) {
-  for (Vec3& p : nodes_) p = center + rotate_about_axis(p - center, unit_axis, angle);
+  const double cs = std::cos(angle), sn = std::sin(angle);  // once, not per node
+  for (Vec3& p : nodes_) p = center + rotate_about_axis(p - center, unit_axis, cs, sn);
   for (std::size_t k = first_frame; k < frames_.size(); ++k) {
-    frames_[k].origin = center + rotate_about_axis(frames_[k].origin - center, unit_axis, angle);
-    frames_[k].axis = rotate_about_axis(frames_[k].axis, unit_axis, angle);
+    frames_[k].origin = center + rotate_about_axis(frames_[k].origin - center, unit_axis, cs, sn);
+    frames_[k].axis = rotate_about_axis(frames_[k].axis, unit_axis, cs, sn);
   }
   update_planes();
   ++version_;

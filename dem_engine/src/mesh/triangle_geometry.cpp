@@ -104,8 +104,11 @@ double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 Vec3 rotate_about_axis(const Vec3& v, const Vec3& k, double angle) {
+  return rotate_about_axis(v, k, std::cos(angle), std::sin(angle));
+}
+
+Vec3 rotate_about_axis(const Vec3& v, const Vec3& k, double cs, double sn) {
   // Rodrigues' formula.
-  const double cs = std::cos(angle), sn = std::sin(angle);
   return cs * v + sn * cross(k, v) + (dot(k, v) * (1.0 - cs)) * k;
 }
 
