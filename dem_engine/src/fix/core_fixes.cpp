@@ -95,9 +95,8 @@ class FixNveSphere : public Fix {
                    P.v.data(), P.omega.data(), P.x.data()};
     sim_.neighbor.partition().for_each(P.size(), [a, bit, dt, half, drift](std::size_t begin,
                                                                            std::size_t end) {
-      const double h = half, step = dt;
-      if (drift) move<true>(a, bit, step, h, begin, end);
-      else move<false>(a, bit, step, h, begin, end);
+      if (drift) move<true>(a, bit, dt, half, begin, end);
+      else move<false>(a, bit, dt, half, begin, end);
     });
   }
 

@@ -103,10 +103,6 @@ double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
   return 0.5 * norm(cross(b - a, c - a));
 }
 
-Vec3 rotate_about_axis(const Vec3& v, const Vec3& k, double angle) {
-  return rotate_about_axis(v, k, std::cos(angle), std::sin(angle));
-}
-
 Vec3 rotate_about_axis(const Vec3& v, const Vec3& k, double cs, double sn) {
   // Rodrigues' formula.
   return cs * v + sn * cross(k, v) + (dot(k, v) * (1.0 - cs)) * k;

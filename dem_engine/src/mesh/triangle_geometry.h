@@ -101,9 +101,8 @@ inline ClosestPoint contact_point_on_triangle(const Vec3& p, const Vec3& a, cons
 Vec3 triangle_normal(const Vec3& a, const Vec3& b, const Vec3& c);
 double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c);
 
-// Rotates v by `angle` (rad) about the unit axis `unit_axis` through the origin (right hand).
-Vec3 rotate_about_axis(const Vec3& v, const Vec3& unit_axis, double angle);
-// The same with the angle's cosine and sine given, for many vectors turned by one angle.
+// Rotates v about the unit axis `unit_axis` through the origin (right hand) by the angle whose
+// cosine and sine are given (computed once for the many vectors one motion turns).
 Vec3 rotate_about_axis(const Vec3& v, const Vec3& unit_axis, double cos_angle, double sin_angle);
 
 }  // namespace dem
