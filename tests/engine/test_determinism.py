@@ -84,3 +84,21 @@ def test_one_and_two_threads_agree(tmp_path):
     assert np.abs(x1 - x2).max() < 1e-9
     assert ke2 == pytest.approx(ke1, rel=1e-6, abs=1e-12)
     assert ke1[-1] < 0.5 * ke1.max()  # the bed did settle
+
+
+@pytest.mark.parametrize(
+    ("dt", "message"),
+    [("2.5e-4", "unstable simulation at step"), ("4e-4", "particles through a fixed boundary")],
+)
+def test_failing_run_reports_the_same_on_one_and_two_threads(tmp_path, dt, message):
+    # Each thread checks its own share of the particles for speeds, non-finite values and
+    # particles outside the box; the error must still be the one of a serial scan (the first
+    # particle at fault in index order, the same count of lost particles).
+    deck = settling_deck(200).replace("timestep 1e-5", f"timestep {dt}")
+    errors = []
+    for threads in (1, 2):
+        run = run_engine(tmp_path / f"t{threads}", deck, threads=threads, check=False)
+        assert run.returncode == 1
+        errors.append(run.stderr.strip().splitlines()[-1])
+    assert message in errors[0], errors[0]
+    assert errors[1] == errors[0]

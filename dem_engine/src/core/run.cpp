@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -103,23 +104,48 @@ void Simulation::check_health() const {
   for (double r : atoms.radius) rmin = std::min(rmin, r);
   // A particle moving more than half its radius in one step cannot be resolved.
   const double vmax = 0.5 * rmin / dt;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3& x = atoms.x[i];
-    const Vec3& v = atoms.v[i];
-    const bool finite = std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z) &&
-                        std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-    if (!finite)
-      throw EngineError("unstable simulation at step " + std::to_string(step) + ": particle " +
-                        std::to_string(atoms.tag[i]) + " has a non-finite position or velocity");
-    const double speed = norm(v);
-    if (speed > vmax)
-      throw EngineError("unstable simulation at step " + std::to_string(step) + ": particle " +
-                        std::to_string(atoms.tag[i]) + " moves at " + format_g(speed) +
-                        " m/s, more than half its radius per time step");
-  }
+  // Each thread checks its own share (one thread reading every position and velocity would
+  // pull them into its cache, and the other threads' next kick would wait to take them back);
+  // the first particle at fault in index order is reported, as a serial scan would.
+  const Vec3* const x = atoms.x.data();
+  const Vec3* const v = atoms.v.data();
+  auto finite = [&](std::size_t i) {
+    return std::isfinite(x[i].x) && std::isfinite(x[i].y) && std::isfinite(x[i].z) &&
+           std::isfinite(v[i].x) && std::isfinite(v[i].y) && std::isfinite(v[i].z);
+  };
+  std::vector<std::size_t> first_bad(static_cast<std::size_t>(omp_get_max_threads()), n);
+  neighbor.partition().for_each(n, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (!finite(i) || norm(v[i]) > vmax) {
+        first_bad[static_cast<std::size_t>(omp_get_thread_num())] = i;
+        return;
+      }
+  });
+  const std::size_t i = *std::min_element(first_bad.begin(), first_bad.end());
+  if (i == n) return;
+  const std::string who = "unstable simulation at step " + std::to_string(step) + ": particle " +
+                          std::to_string(atoms.tag[i]);
+  if (!finite(i)) throw EngineError(who + " has a non-finite position or velocity");
+  throw EngineError(who + " moves at " + format_g(norm(v[i])) +
+                    " m/s, more than half its radius per time step");
 }
 
 void Simulation::handle_lost_particles() {
+  // Most calls find every particle inside the box: each thread looks at its own share first
+  // (see check_health), and only a particle outside makes the serial pass below run.
+  const Vec3* const x_all = atoms.x.data();
+  std::atomic<bool> outside{false};
+  neighbor.partition().for_each(atoms.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      for (int k = 0; k < 3; ++k) {
+        const double c = x_all[i][k];
+        if (c < domain.lo[k] || (domain.periodic(k) ? c >= domain.hi[k] : c > domain.hi[k])) {
+          outside.store(true, std::memory_order_relaxed);
+          return;
+        }
+      }
+  });
+  if (!outside.load()) return;
   std::vector<char> lost(atoms.size(), 0);
   bool any_lost = false;
   for (std::size_t i = 0; i < atoms.size(); ++i) {
