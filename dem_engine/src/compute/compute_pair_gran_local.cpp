@@ -98,7 +98,18 @@ class ForceEvaluationVelocities final : public Fix {
   ForceEvaluationVelocities(Simulation& sim, const std::string& fix_id,
                             const std::string& compute_id, const SourceLocation& where)
       : Fix(sim, fix_command(fix_id, where)), compute_id_(compute_id) {}
-  void post_force() override {
+  HookWork post_force_work() override {
+    HookWork work;
+    work.before = [this] { copy(); };
+    return work;
+  }
+  // True when the copy was taken at this step for the current particles.
+  bool current() const { return step_ == sim_.step && v_.size() == sim_.atoms.size(); }
+  const Vec3& v(std::size_t i) const { return v_[i]; }
+  const Vec3& omega(std::size_t i) const { return omega_[i]; }
+
+ private:
+  void copy() {
     const Domain& box = sim_.domain;
     if (!(box.periodic(0) || box.periodic(1) || box.periodic(2))) return;
     const bool compute_exists =
@@ -110,12 +121,6 @@ class ForceEvaluationVelocities final : public Fix {
     omega_ = sim_.atoms.omega;
     step_ = sim_.step;
   }
-  // True when the copy was taken at this step for the current particles.
-  bool current() const { return step_ == sim_.step && v_.size() == sim_.atoms.size(); }
-  const Vec3& v(std::size_t i) const { return v_[i]; }
-  const Vec3& omega(std::size_t i) const { return omega_[i]; }
-
- private:
   static Command fix_command(const std::string& fix_id, const SourceLocation& where) {
     Command command;
     command.where = where;

@@ -60,6 +60,38 @@ class Progress {
 }  // namespace
 
 void Simulation::compute_forces() {
+  pair_forces();
+  force_hooks(false);
+}
+
+void Simulation::force_hooks(bool final) {
+  std::vector<HookWork> batch;  // hooks with a share, not yet run
+  auto flush = [&]() {
+    if (batch.empty()) return;
+    for (HookWork& w : batch)
+      if (w.before) w.before();
+    neighbor.partition().for_each(atoms.size(), [&](std::size_t begin, std::size_t end) {
+      for (HookWork& w : batch) w.share(begin, end);
+    });
+    for (HookWork& w : batch)
+      if (w.after) w.after();
+    batch.clear();
+  };
+  for (int pass = 0; pass < (final ? 2 : 1); ++pass)
+    for (auto& f : fixes) {
+      HookWork w = pass == 0 ? f->post_force_work() : f->final_integrate_work();
+      if (w.share) {
+        batch.push_back(std::move(w));
+      } else if (w.before || w.after) {
+        flush();
+        if (w.before) w.before();
+        if (w.after) w.after();
+      }
+    }
+  flush();
+}
+
+void Simulation::pair_forces() {
   const std::size_t n = atoms.size();
   if (!pair || n == 0) {
     std::fill(atoms.f.begin(), atoms.f.end(), Vec3{});
@@ -84,7 +116,6 @@ void Simulation::compute_forces() {
     if (args.max_overlap_ratio > DeepOverlaps::kRatio)
       note_deep_overlap(args.max_overlap_ratio, args.max_overlap_tag, "a neighbour");
   }
-  for (auto& f : fixes) f->post_force();
 }
 
 void Simulation::note_deep_overlap(double ratio, long tag, const std::string& partner) {
@@ -247,8 +278,8 @@ void Simulation::integrate_step() {
     neighbor.build(atoms, domain);
     last_build_step_ = step;
   }
-  compute_forces();
-  for (auto& f : fixes) f->final_integrate();
+  pair_forces();
+  force_hooks(true);
   for (auto& f : fixes) f->end_of_step();
 }
 

@@ -109,7 +109,11 @@ class Simulation : public CommandHandler, public EvalContext {
   void run(const Command& command);
   void setup_run();
   void integrate_step();
-  void compute_forces();
+  void compute_forces();  // pair forces, then every fix's post_force
+  void pair_forces();
+  // The fixes' post_force (and with final, then their final_integrate) in fix order; the shares
+  // of consecutive hooks run in one parallel region (see HookWork).
+  void force_hooks(bool final);
   void check_timestep();
   void check_health() const;
   void handle_lost_particles();

@@ -54,19 +54,20 @@ class FixGravity : public Fix {
     if (len == 0.0) throw EngineError("gravity direction is zero");
     accel_ = (g / len) * dir;
   }
-  void post_force() override {
-    auto& P = sim_.atoms;
-    const std::uint32_t bit = group_bit();
-    // Locals of the lambda: a store to a force could alias accel_, reloaded after each one.
-    const std::uint32_t* const mask = P.mask.data();
-    const double* const mass = P.rmass.data();
-    Vec3* const f = P.f.data();
-    sim_.neighbor.partition().for_each(P.size(), [mask, mass, f, bit, g = accel_](
-                                                     std::size_t begin, std::size_t end) {
-      const Vec3 a = g;
+  HookWork post_force_work() override {
+    HookWork work;
+    work.share = [this](std::size_t begin, std::size_t end) {
+      auto& P = sim_.atoms;
+      const std::uint32_t bit = group_bit();
+      // Locals: a store to a force could alias accel_, which would be reloaded after each one.
+      const std::uint32_t* const mask = P.mask.data();
+      const double* const mass = P.rmass.data();
+      Vec3* const f = P.f.data();
+      const Vec3 a = accel_;
       for (std::size_t i = begin; i < end; ++i)
         if (mask[i] & bit) f[i] += mass[i] * a;
-    });
+    };
+    return work;
   }
   const Vec3& acceleration() const { return accel_; }
 
@@ -80,24 +81,33 @@ class FixNveSphere : public Fix {
   FixNveSphere(Simulation& sim, const Command& c) : Fix(sim, c) {
     if (!args().empty()) throw EngineError("fix nve/sphere takes no arguments here");
   }
-  void initial_integrate() override { kick(true); }
-  void final_integrate() override { kick(false); }
+  void initial_integrate() override {
+    update_inverses();
+    sim_.neighbor.partition().for_each(sim_.atoms.size(), share_kick(true));
+  }
+  HookWork final_integrate_work() override {
+    HookWork work;
+    work.before = [this] { update_inverses(); };
+    work.share = share_kick(false);
+    return work;
+  }
 
  private:
-  void kick(bool drift) {
+  // The kick (with drift, also the drift) of one share; the inverses must be up to date when
+  // it runs.
+  std::function<void(std::size_t, std::size_t)> share_kick(bool drift) {
     auto& P = sim_.atoms;
     const double dt = sim_.dt, half = 0.5 * dt;
     const std::uint32_t bit = group_bit();
-    update_inverses();
-    // Everything the loop reads as locals of the lambda: a store to a velocity could alias
-    // any double reached through a reference, which would be reloaded after every store.
-    const Arrays a{P.mask.data(), inv_m_.data(), inv_i_.data(), P.f.data(), P.torque.data(),
-                   P.v.data(), P.omega.data(), P.x.data()};
-    sim_.neighbor.partition().for_each(P.size(), [a, bit, dt, half, drift](std::size_t begin,
-                                                                           std::size_t end) {
+    // Everything the loop reads as locals (copied into move): a store to a velocity could
+    // alias any double reached through a reference, which would be reloaded after every store.
+    // The arrays are taken when the share runs, after update_inverses may have moved them.
+    return [this, &P, bit, dt, half, drift](std::size_t begin, std::size_t end) {
+      const Arrays a{P.mask.data(), inv_m_.data(), inv_i_.data(), P.f.data(), P.torque.data(),
+                     P.v.data(),    P.omega.data(), P.x.data()};
       if (drift) move<true>(a, bit, dt, half, begin, end);
       else move<false>(a, bit, dt, half, begin, end);
-    });
+    };
   }
 
   struct Arrays {
@@ -147,13 +157,17 @@ class FixFreeze : public Fix {
   FixFreeze(Simulation& sim, const Command& c) : Fix(sim, c) {
     if (!args().empty()) throw EngineError("fix freeze takes no arguments");
   }
-  void post_force() override {
-    auto& P = sim_.atoms;
-    for (std::size_t i = 0; i < P.size(); ++i)
-      if (P.mask[i] & group_bit()) {
-        P.f[i] = Vec3{};
-        P.torque[i] = Vec3{};
-      }
+  HookWork post_force_work() override {
+    HookWork work;
+    work.share = [this](std::size_t begin, std::size_t end) {
+      auto& P = sim_.atoms;
+      for (std::size_t i = begin; i < end; ++i)
+        if (P.mask[i] & group_bit()) {
+          P.f[i] = Vec3{};
+          P.torque[i] = Vec3{};
+        }
+    };
+    return work;
   }
 };
 

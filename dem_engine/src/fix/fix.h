@@ -1,4 +1,5 @@
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -11,6 +12,19 @@
 namespace dem {
 
 class Simulation;
+
+// What a fix does in post_force or final_integrate. `share` is its work on one thread's share
+// of the particles, [begin, end), and may touch, per particle, only that particle (its force,
+// torque, velocity, position and per-particle storage): consecutive hooks with a share, of any
+// fixes, run in one parallel region with no barrier between them (each barrier costs the
+// imbalance of the loop before it). `before` runs once before those shares and must not depend
+// on the shares of the hooks before it; `after` runs once after all of them. A hook without a
+// share runs `before`, then `after`, once every earlier hook has finished. Empty: nothing.
+struct HookWork {
+  std::function<void()> before;
+  std::function<void(std::size_t, std::size_t)> share;
+  std::function<void()> after;
+};
 
 // A LIGGGHTS fix: `fix ID GROUP STYLE args...`. The hooks run in this order every step:
 // initial_integrate, post_integrate, [pre_exchange + neighbour rebuild when needed],
@@ -34,8 +48,8 @@ class Fix {
   virtual void initial_integrate() {}
   virtual void post_integrate() {}
   virtual void pre_exchange() {}  // insertion/deletion; call sim.particles_changed() after
-  virtual void post_force() {}
-  virtual void final_integrate() {}
+  virtual HookWork post_force_work() { return {}; }
+  virtual HookWork final_integrate_work() { return {}; }
   virtual void end_of_step() {}
   virtual void post_run() {}
 

@@ -327,7 +327,13 @@ void FixMeshSurfaceStressServo::initial_integrate() {
   mesh_.add_velocity(speed_ * axis_);
 }
 
-void FixMeshSurfaceStressServo::final_integrate() {
+HookWork FixMeshSurfaceStressServo::final_integrate_work() {
+  HookWork work;
+  work.before = [this] { update_speed(); };
+  return work;
+}
+
+void FixMeshSurfaceStressServo::update_speed() {
   if (!integrate_) return;
   if (!target_variable_.empty())
     controller_.set_target(sim_.variables.number(target_variable_, sim_));

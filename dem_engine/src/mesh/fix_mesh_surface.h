@@ -90,11 +90,12 @@ class FixMeshSurfaceStressServo : public FixMeshSurfaceStress {
   void init() override;
   void setup() override;
   void initial_integrate() override;
-  void final_integrate() override;
+  HookWork final_integrate_work() override;
   double max_wall_speed() const override { return controller_.vel_max; }
 
  private:
   void set_target(const std::string& word);
+  void update_speed();
   ServoController controller_;
   Vec3 com_, axis_;
   double speed_ = 0.0;  // current speed along the axis (m/s)

@@ -164,9 +164,21 @@ void FixWallGran::init() {
   }
 }
 
-void FixWallGran::post_force() {
-  if (mesh_mode_) mesh_forces();
-  else primitive_forces();
+HookWork FixWallGran::post_force_work() {
+  HookWork work;
+  if (mesh_mode_) {  // per-thread sums of the loads on the meshes; one region of its own
+    work.before = [this] { mesh_forces(); };
+    return work;
+  }
+  work.before = [this] {
+    const Particles& P = sim_.atoms;
+    if (near_builds_ != sim_.neighbor.builds() || near_count_of_ != P.size()) find_near_primitive();
+    worst_ = 0.0;
+    worst_tag_ = -1;
+  };
+  work.share = [this](std::size_t begin, std::size_t end) { primitive_share(begin, end); };
+  work.after = [this] { finish_step(worst_, worst_tag_, 0); };
+  return work;
 }
 
 void FixWallGran::find_near_primitive() {
@@ -190,62 +202,52 @@ void FixWallGran::find_near_primitive() {
   near_count_of_ = n;
 }
 
-void FixWallGran::primitive_forces() {
+void FixWallGran::primitive_share(std::size_t begin, std::size_t end) {
   Particles& P = sim_.atoms;
-  if (near_builds_ != sim_.neighbor.builds() || near_count_of_ != P.size()) find_near_primitive();
-  const std::size_t n = P.size();
   double* hist_all = P.extra(history_).data();
-  double worst = 0.0;
-  long worst_tag = -1;
   const ContactModel& model = sim_.pair_model();
   const ContactStep step = sim_.wall_step();
-#pragma omp parallel num_threads(worker_threads(n)) if (n >= kParallelMin)
-  {
-    double my_worst = 0.0;
-    long my_tag = -1;
-    // The candidates (sorted) in the thread's own share of the particles.
-    const ParticleShare own =
-        sim_.neighbor.partition().share(n, omp_get_thread_num(), omp_get_num_threads());
-    const auto from = std::lower_bound(near_.begin(), near_.end(), own.begin);
-    const auto to = std::lower_bound(from, near_.end(), own.end);
-    // Contacts are collected in chunks and their laws run together (ContactModel::wall_forces,
-    // two at a time); each particle has one contact with this wall, so the order in which the
-    // forces are added changes no sum.
-    WallContact chunk[kWallChunk];
-    ContactResult results[kWallChunk];
-    std::size_t count = 0;
-    auto flush = [&]() {
-      model.wall_forces(P, sim_.material, step, chunk, count, results);
-      add_wall_results(P, chunk, results, count, my_worst, my_tag);
-      count = 0;
-    };
-    for (auto it = from; it != to; ++it) {
-      const std::size_t i = *it;
-      double* hist = hist_all + i * kHistorySize;
-      Vec3 normal;
-      double dist = 0.0;
-      if (!wall_.contact(P.x[i], P.radius[i], normal, dist)) {
-        std::fill(hist, hist + kHistorySize, 0.0);
-        continue;
-      }
-      WallContact& c = chunk[count++];
-      c.i = i;
-      c.normal = normal;
-      c.overlap = P.radius[i] - dist;
-      c.dist = dist;
-      c.wall_velocity = Vec3{};
-      c.wall_type = wall_type_;
-      c.history = hist;
-      if (count == kWallChunk) flush();
+  double my_worst = 0.0;
+  long my_tag = -1;
+  // The candidates (sorted) in this share of the particles.
+  const auto from = std::lower_bound(near_.begin(), near_.end(), begin);
+  const auto to = std::lower_bound(from, near_.end(), end);
+  // Contacts are collected in chunks and their laws run together (ContactModel::wall_forces,
+  // two at a time); each particle has one contact with this wall, so the order in which the
+  // forces are added changes no sum.
+  WallContact chunk[kWallChunk];
+  ContactResult results[kWallChunk];
+  std::size_t count = 0;
+  auto flush = [&]() {
+    model.wall_forces(P, sim_.material, step, chunk, count, results);
+    add_wall_results(P, chunk, results, count, my_worst, my_tag);
+    count = 0;
+  };
+  for (auto it = from; it != to; ++it) {
+    const std::size_t i = *it;
+    double* hist = hist_all + i * kHistorySize;
+    Vec3 normal;
+    double dist = 0.0;
+    if (!wall_.contact(P.x[i], P.radius[i], normal, dist)) {
+      std::fill(hist, hist + kHistorySize, 0.0);
+      continue;
     }
-    flush();
-#pragma omp critical
-    if (my_worst > worst || (my_worst == worst && my_tag >= 0 && my_tag < worst_tag)) {
-      worst = my_worst;
-      worst_tag = my_tag;
-    }
+    WallContact& c = chunk[count++];
+    c.i = i;
+    c.normal = normal;
+    c.overlap = P.radius[i] - dist;
+    c.dist = dist;
+    c.wall_velocity = Vec3{};
+    c.wall_type = wall_type_;
+    c.history = hist;
+    if (count == kWallChunk) flush();
   }
-  finish_step(worst, worst_tag, 0);
+  flush();
+#pragma omp critical
+  if (my_worst > worst_ || (my_worst == worst_ && my_tag >= 0 && my_tag < worst_tag_)) {
+    worst_ = my_worst;
+    worst_tag_ = my_tag;
+  }
 }
 
 void FixWallGran::mesh_forces() {

@@ -26,7 +26,7 @@ class FixWallGran : public Fix {
  public:
   FixWallGran(Simulation& sim, const Command& command);
   void init() override;
-  void post_force() override;
+  HookWork post_force_work() override;
 
   const TriangleNeighborList& triangle_list() const { return list_; }
   bool mesh_mode() const { return mesh_mode_; }
@@ -34,7 +34,7 @@ class FixWallGran : public Fix {
  private:
   void check_model() const;
   void check_single_mesh_wall() const;
-  void primitive_forces();
+  void primitive_share(std::size_t begin, std::size_t end);
   void find_near_primitive();
   void mesh_forces();
   void finish_step(double worst_ratio, long worst_tag, long overflow);
@@ -49,6 +49,9 @@ class FixWallGran : public Fix {
   std::vector<std::size_t> near_;
   long near_builds_ = -1;
   std::size_t near_count_of_ = 0;
+  // This step's deepest overlap with the primitive wall over the shares so far, and its particle.
+  double worst_ = 0.0;
+  long worst_tag_ = -1;
   // mesh
   std::vector<std::string> mesh_ids_;
   std::vector<FixMeshSurface*> mesh_fixes_;  // refreshed at every init
