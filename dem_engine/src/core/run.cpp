@@ -164,17 +164,20 @@ void Simulation::check_health() const {
 void Simulation::handle_lost_particles() {
   // Most calls find every particle inside the box: each thread looks at its own share first
   // (see check_health), and only a particle outside makes the serial pass below run.
+  // Outside the box along axis k (a periodic box is half-open); read at each call, as the
+  // serial pass widens a shrink-wrapped box.
+  auto outside_along = [this](double c, int k) {
+    return c < domain.lo[k] || (domain.periodic(k) ? c >= domain.hi[k] : c > domain.hi[k]);
+  };
   const Vec3* const x_all = atoms.x.data();
   std::atomic<bool> outside{false};
   neighbor.partition().for_each(atoms.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i)
-      for (int k = 0; k < 3; ++k) {
-        const double c = x_all[i][k];
-        if (c < domain.lo[k] || (domain.periodic(k) ? c >= domain.hi[k] : c > domain.hi[k])) {
+      for (int k = 0; k < 3; ++k)
+        if (outside_along(x_all[i][k], k)) {
           outside.store(true, std::memory_order_relaxed);
           return;
         }
-      }
   });
   if (!outside.load()) return;
   std::vector<char> lost(atoms.size(), 0);
@@ -182,19 +185,18 @@ void Simulation::handle_lost_particles() {
   for (std::size_t i = 0; i < atoms.size(); ++i) {
     Vec3& x = atoms.x[i];
     for (int k = 0; k < 3; ++k) {
+      if (!outside_along(x[k], k)) continue;
       const double lo = domain.lo[k], hi = domain.hi[k];
       if (domain.periodic(k)) {
         const double len = hi - lo;
         while (x[k] < lo) x[k] += len;
         while (x[k] >= hi) x[k] -= len;
-      } else if (x[k] < lo || x[k] > hi) {
-        if (domain.boundary[k] == 'f') {
-          lost[i] = 1;
-          any_lost = true;
-        } else {  // shrink-wrapped: the box follows the particles
-          domain.lo[k] = std::min(lo, x[k]);
-          domain.hi[k] = std::max(hi, x[k]);
-        }
+      } else if (domain.boundary[k] == 'f') {
+        lost[i] = 1;
+        any_lost = true;
+      } else {  // shrink-wrapped: the box follows the particles
+        domain.lo[k] = std::min(lo, x[k]);
+        domain.hi[k] = std::max(hi, x[k]);
       }
     }
   }

@@ -96,17 +96,16 @@ class FixNveSphere : public Fix {
   // The kick (with drift, also the drift) of one share; the inverses must be up to date when
   // it runs.
   std::function<void(std::size_t, std::size_t)> share_kick(bool drift) {
-    auto& P = sim_.atoms;
-    const double dt = sim_.dt, half = 0.5 * dt;
-    const std::uint32_t bit = group_bit();
-    // Everything the loop reads as locals (copied into move): a store to a velocity could
-    // alias any double reached through a reference, which would be reloaded after every store.
-    // The arrays are taken when the share runs, after update_inverses may have moved them.
-    return [this, &P, bit, dt, half, drift](std::size_t begin, std::size_t end) {
+    return [this, drift](std::size_t begin, std::size_t end) {
+      auto& P = sim_.atoms;
+      const double dt = sim_.dt, half = 0.5 * dt;
+      // Everything the loop reads as locals (copied into move): a store to a velocity could
+      // alias any double reached through a reference, which would be reloaded after every
+      // store. The arrays are taken here, after update_inverses may have moved them.
       const Arrays a{P.mask.data(), inv_m_.data(), inv_i_.data(), P.f.data(), P.torque.data(),
                      P.v.data(),    P.omega.data(), P.x.data()};
-      if (drift) move<true>(a, bit, dt, half, begin, end);
-      else move<false>(a, bit, dt, half, begin, end);
+      if (drift) move<true>(a, group_bit(), dt, half, begin, end);
+      else move<false>(a, group_bit(), dt, half, begin, end);
     };
   }
 
