@@ -39,9 +39,11 @@ import pandas as pd  # noqa: E402
 
 from demcal.bulk.convergence import (  # noqa: E402
     FACTORS,
+    Factor,
     parse_parameter_set,
     plan_study,
     quantities_of,
+    restrict_levels,
     summarise,
 )
 from demcal.bulk.engine_comparison import (  # noqa: E402
@@ -73,6 +75,13 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         help="a further parameter set, e.g. where a calibration landed (every contact "
         "parameter: coefficientFriction, coefficientRollingFriction, coefficientRestitution, "
         "density); repeatable",
+    )
+    parser.add_argument(
+        "--levels",
+        type=float,
+        nargs="+",
+        help="run only these levels of every factor named (the most refined of them is the "
+        "reference), e.g. --factors aor_dCylDp --levels 9 14",
     )
     parser.add_argument("--seeds", type=int, default=3, help="seeds per level and set")
     parser.add_argument("--normal-stress", type=float, default=10070.0, help="pre-shear, Pa")
@@ -116,10 +125,10 @@ def _set_text(params: dict[str, float]) -> str:
     return "(" + ", ".join(f"{PARAMETERS[k].symbol} {v:g}" for k, v in params.items()) + ")"
 
 
-def _markdown(summary: pd.DataFrame, header: str) -> str:
+def _markdown(summary: pd.DataFrame, header: str, factors: dict[str, Factor]) -> str:
     lines = [header, ""]
     for name, rows in summary.groupby("factor", sort=False):
-        factor = FACTORS[str(name)]
+        factor = factors[str(name)]
         lines += [f"### {name}: {factor.label}", ""]
         lines += [
             "| level | set | quantity | n | mean | sd | deviation (+- 1 se) | within tolerance |"
@@ -181,7 +190,13 @@ def main(argv: list[str] | None = None) -> int:
         sets[name] = params
     if not sets:
         raise SystemExit("no parameter sets: name some with --sets or add one with --extra-set")
-    factors = [FACTORS[name] for name in args.factors]
+    chosen = {name: FACTORS[name] for name in args.factors}
+    if args.levels:
+        try:
+            chosen = {name: restrict_levels(f, args.levels) for name, f in chosen.items()}
+        except ValueError as exc:
+            raise SystemExit(f"--levels: {exc}") from None
+    factors = list(chosen.values())
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     seeds = list(range(1, args.seeds + 1))
@@ -208,12 +223,12 @@ def main(argv: list[str] | None = None) -> int:
     for job, name, overrides in planned:
         values = collect_values([job])
         values["factor"] = name
-        values["level"] = FACTORS[name].level_value(overrides)
+        values["level"] = chosen[name].level_value(overrides)
         values["overrides"] = json.dumps(dict(overrides), sort_keys=True)
         frames.append(values[values["quantity"].isin(quantities_of(job.test))])
     values = pd.concat(frames, ignore_index=True)
     values.to_csv(out / "values.csv", index=False)
-    summary = summarise(values, FACTORS)
+    summary = summarise(values, chosen)
     summary.to_csv(out / "summary.csv", index=False)
     for factor in factors:
         if factor.name in set(summary["factor"]):
@@ -227,7 +242,7 @@ def main(argv: list[str] | None = None) -> int:
         f"wall time of this call {(time.monotonic() - t0) / 60:.1f} min, "
         f"{len(unique)} distinct runs, {len(failed)} without values."
     )
-    text = _markdown(summary, header)
+    text = _markdown(summary, header, chosen)
     if len(failed):
         text += "\nRuns without values:\n\n" + "\n".join(
             f"- {r.factor} = {r.level:g}, {r.set}, seed {r.seed}: {r.status}"

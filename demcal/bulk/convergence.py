@@ -19,7 +19,7 @@ import copy
 import json
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -207,6 +207,31 @@ FACTORS: dict[str, Factor] = {
         ),
     )
 }
+
+
+def restrict_levels(factor: Factor, values: Sequence[float]) -> Factor:
+    """The factor with only the levels whose plotted value is one of ``values``.
+
+    The most refined level left is the reference. Useful to repeat a cheap comparison (e.g.
+    the quick heap against the next larger one) with many seeds without the costliest level.
+
+    Raises
+    ------
+    ValueError
+        When a value is not a level of the factor; the message lists its levels.
+    """
+    known = [factor.level_value(level) for level in factor.levels]
+    unknown = [v for v in values if not any(abs(v - k) <= 1e-9 * max(1.0, abs(k)) for k in known)]
+    if unknown:
+        raise ValueError(
+            f"factor {factor.name}: {unknown} are not among its levels {[f'{k:g}' for k in known]}"
+        )
+    kept = tuple(
+        level
+        for level in factor.levels
+        if any(abs(factor.level_value(level) - v) <= 1e-9 * max(1.0, abs(v)) for v in values)
+    )
+    return replace(factor, levels=kept)
 
 
 def parse_parameter_set(text: str) -> tuple[str, dict[str, float]]:

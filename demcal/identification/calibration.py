@@ -6,7 +6,7 @@ repose alone (AoR), and both (shear-cell conditions, then AoR on the marked sets
 
 import gzip
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -16,7 +16,7 @@ import pandas as pd
 import torch
 
 from demcal.core.experiments import Experiment
-from demcal.identification.acceptance import within_tolerance
+from demcal.identification.acceptance import relative_deviation, within_tolerance
 from demcal.identification.candidate_grid import draw_axes
 from demcal.identification.screening import screen
 from demcal.identification.screening_stages import Stage, stage_from_condition
@@ -70,6 +70,65 @@ class CalibrationResult:
     table5: pd.DataFrame
     identified: dict[str, dict[str, float]]
     identified_group: str
+    # The surrogates' predictions at the identified mean set (:func:`predictions_at`).
+    at_identified: list[dict[str, Any]] = field(default_factory=list)
+
+
+def predictions_at(
+    point: Mapping[str, float],
+    predictors: Mapping[str, tuple[ConstantInputs, Sequence[str]]],
+    experiment: Experiment,
+    tol: float,
+) -> list[dict[str, Any]]:
+    """The surrogates' prediction of every measured value at one parameter set.
+
+    The mean of the valid sets need not be valid itself: when the valid region is curved or
+    thin, its mean lies outside it, and a verification there misses although the screening
+    worked. These predictions tell the two apart before any DEM run.
+
+    Parameters
+    ----------
+    point : mapping
+        Parameter name -> value (SI units), e.g. the identified means.
+    predictors : mapping
+        Output name -> (predictor, its free input names), as screened.
+    experiment : Experiment
+        The measurements.
+    tol : float
+        Relative acceptance tolerance.
+
+    Returns
+    -------
+    list of dict
+        Per measured value with a predictor, in the experiment's order: ``observable``,
+        ``normal_stress`` (Pa) and ``P`` (None for the angle of repose), ``measured``,
+        ``predicted``, ``deviation`` (|1 - predicted / measured|) and ``within_tolerance``.
+    """
+    checks = [(c.values, c.load) for c in experiment.shear_conditions]
+    if experiment.angle_of_repose is not None:
+        checks.append(({"aor": experiment.angle_of_repose}, {}))
+    out: list[dict[str, Any]] = []
+    for values, load in checks:
+        inputs = {**point, **load}
+        for name, measured in values.items():
+            if name not in predictors:
+                continue
+            model, free = predictors[name]
+            x = np.array([[float(inputs[f]) for f in free]])
+            predicted = float(model.predict(x)[0])
+            accepted = within_tolerance({name: np.array([predicted])}, {name: measured}, tol)
+            out.append(
+                {
+                    "observable": name,
+                    "normal_stress": load.get("normal_stress"),
+                    "P": load.get("P"),
+                    "measured": float(measured),
+                    "predicted": predicted,
+                    "deviation": float(relative_deviation(predicted, measured)),
+                    "within_tolerance": bool(accepted[0]),
+                }
+            )
+    return out
 
 
 def _aor_stage(value: float, tol: float) -> Stage:
@@ -153,7 +212,14 @@ def calibrate(
     table5 = combine_statistics(tables) if tables else pd.DataFrame()
     chosen = next((g for g in reversed(GROUPS) if g in valid and len(valid[g]) > 0), None)
     identified = identified_parameters(valid[chosen], list(axes)) if chosen else {}
-    return CalibrationResult(axes, valid, n_total, elapsed, table5, identified, chosen or "")
+    at_identified = (
+        predictions_at({k: v["mean"] for k, v in identified.items()}, predictors, experiment, tol)
+        if identified
+        else []
+    )
+    return CalibrationResult(
+        axes, valid, n_total, elapsed, table5, identified, chosen or "", at_identified
+    )
 
 
 def valid_sets_file(out_dir: str | Path, group: str) -> Path:

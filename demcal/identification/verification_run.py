@@ -55,6 +55,39 @@ def render_verification_case(
     return case
 
 
+#: Column of the verification table with the surrogates' prediction at the verified set.
+SURROGATE_COLUMN = "surrogate"
+
+
+def _key(observable: str, normal_stress: Any, P: Any) -> str:
+    """Row key; a missing load (the angle of repose) reads "-", as NaN never compares equal."""
+
+    def number(v: Any) -> str:
+        return "-" if v is None or pd.isna(v) else f"{float(v):.9g}"
+
+    return f"{observable}|{number(normal_stress)}|{number(P)}"
+
+
+def surrogate_column(table: pd.DataFrame, predicted: list[Mapping[str, Any]]) -> pd.Series:
+    """The surrogates' prediction for each row of a verification table (NaN where none).
+
+    Parameters
+    ----------
+    table : pandas.DataFrame, shape (n_measured, ...)
+        Columns ``observable``, ``normal_stress`` (Pa), ``P``.
+    predicted : list of mapping
+        ``predicted_at_mean`` of the identified-set record: ``observable``, ``normal_stress``,
+        ``P``, ``predicted``.
+
+    Returns
+    -------
+    pandas.Series, shape (n_measured,)
+    """
+    lookup = {_key(r["observable"], r["normal_stress"], r["P"]): r["predicted"] for r in predicted}
+    rows = table[["observable", "normal_stress", "P"]].itertuples(index=False)
+    return pd.Series([lookup.get(_key(*row), float("nan")) for row in rows], index=table.index)
+
+
 def write_verification_table(
     bulk_files: Mapping[str, Iterable[str | Path]],
     experiment_file: str | Path,
@@ -84,7 +117,9 @@ def write_verification_table(
         Threads or MPI ranks of each run, listed with the commands.
     identified : path, optional
         The identified-set record; its reachability verdict (``reach``, written by
-        :func:`demcal.identification.identify.identify`) becomes the first line of the text.
+        :func:`demcal.identification.identify.identify`) becomes the first line of the text,
+        followed by whether the surrogates accept the mean set itself (``mean_set``); their
+        predictions there (``predicted_at_mean``) become the column ``surrogate``.
 
     Returns
     -------
@@ -97,12 +132,15 @@ def write_verification_table(
         for engine, files in bulk_files.items()
     }
     table = verification_table(runs, load_experiment(experiment_file), float(tolerance))
+    record = json.loads(Path(identified).read_text()) if identified is not None else {}
+    if record.get("predicted_at_mean"):
+        table[SURROGATE_COLUMN] = surrogate_column(table, record["predicted_at_mean"])
     table.to_csv(csv, index=False)
     lines = ["# Verification: DEM at the identified mean set vs measurement", ""]
-    if identified is not None:
-        verdict = json.loads(Path(identified).read_text()).get("reach")
-        if verdict:
-            lines = [verdict, "", *lines]
+    lines = [
+        *(f"{record[key]}\n" for key in ("reach", "mean_set") if record.get(key)),
+        *lines,
+    ]
     lines.append(
         "Engines (columns dem_<engine>: mean over replicate runs, dem_sd_<engine>: their standard "
         "deviation, runs_<engine>: runs that finished, deviation_<engine> = |1 - dem/measured|):"
@@ -115,6 +153,11 @@ def write_verification_table(
         first = next(iter(runs))
         lines.append(
             f"engine_difference: largest |1 - dem_<engine>/dem_{first}| over the other engines."
+        )
+    if SURROGATE_COLUMN in table:
+        lines.append(
+            f"{SURROGATE_COLUMN}: the surrogates' prediction at the identified mean set (the "
+            "screening accepted the valid sets on such predictions)."
         )
     lines.append(f"Tolerance: {float(tolerance):g}")
     for engine, frame in runs.items():

@@ -12,7 +12,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.bulk.convergence import FACTORS, Factor, parse_parameter_set, plan_study, summarise
+from demcal.bulk.convergence import (
+    FACTORS,
+    Factor,
+    parse_parameter_set,
+    plan_study,
+    restrict_levels,
+    summarise,
+)
 from demcal.core.config import load_config
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -204,6 +211,10 @@ def test_parse_parameter_set_names_what_is_wrong(text: str, message: str) -> Non
         (["--sets", "medium"], "unknown parameter sets ['medium']"),
         (["--extra-set", "s=coefficientFriction:0.5"], "--extra-set: parameter set s: missing"),
         (
+            ["--factors", "aor_dCylDp", "--levels", "9", "12"],
+            "--levels: factor aor_dCylDp: [12.0] are not among its levels ['6', '9', '14', '20']",
+        ),
+        (
             ["--extra-set", "middle=" + ",".join(f"{k}:{v}" for k, v in MIDDLE.items())],
             "a set named middle is already in the study",
         ),
@@ -221,3 +232,23 @@ def test_convergence_script_stops_on_bad_sets_before_any_run(
     )
     assert res.returncode != 0 and message in res.stderr, res.stderr
     assert not out.exists()
+
+
+def test_restricted_levels_keep_their_order_and_the_most_refined_is_the_reference() -> None:
+    heap = restrict_levels(FACTORS["aor_dCylDp"], [14.0, 9.0])
+    assert [heap.level_value(v) for v in heap.levels] == [9.0, 14.0]
+    assert heap.levels[-1] == FACTORS["aor_dCylDp"].levels[2]
+    values = pd.DataFrame(
+        {
+            "factor": "aor_dCylDp",
+            "set": "s",
+            "quantity": "aor",
+            "level": [9.0, 9.0, 14.0, 14.0],
+            "seed": [1, 2, 1, 2],
+            "value": [36.0, 34.0, 35.0, 35.0],
+        }
+    )
+    summary = summarise(values, {"aor_dCylDp": heap}).set_index("level")
+    assert summary.loc[14.0, "reference"] == 35.0 and summary.loc[9.0, "deviation"] == 0.0
+    with pytest.raises(ValueError, match="not among its levels"):
+        restrict_levels(FACTORS["aor_lift_time"], [3.0])

@@ -30,6 +30,7 @@ from demcal.identification.calibration import (
     calibrate,
     write_valid_sets,
 )
+from demcal.identification.identify import mean_set_statement
 from demcal.identification.verification import verification_table
 from demcal.identification.verification_run import write_verification_table
 from tests.engine.conftest import engine_path
@@ -259,6 +260,58 @@ def test_calibration_recovers_truth_with_analytic_surrogates():
     assert set(both["coefficientRestitution"]) == set(result.axes["coefficientRestitution"])
     assert result.identified_group == "SSC & AoR"
     assert result.identified["density"]["mean"] == pytest.approx(3000.0, rel=0.05)
+    # The surrogates at the identified mean: the linear models evaluated by hand.
+    mean = {k: v["mean"] for k, v in result.identified.items()}
+    at = {r["observable"]: r for r in result.at_identified}
+    assert list(at) == ["mu_psh", "rho_b", "aor"]
+    mu_s, mu_r = mean["coefficientFriction"], mean["coefficientRollingFriction"]
+    assert at["mu_psh"]["predicted"] == pytest.approx(0.2 + 0.5 * mu_s + 0.2 * mu_r, rel=1e-5)
+    assert at["aor"]["predicted"] == pytest.approx(10.0 + 10.0 * mu_s + 30.0 * mu_r)
+    assert (at["rho_b"]["normal_stress"], at["rho_b"]["P"], at["aor"]["P"]) == (2029.0, 1.0, None)
+    for row in at.values():
+        assert row["deviation"] == pytest.approx(abs(1 - row["predicted"] / row["measured"]))
+        assert row["within_tolerance"] == (row["deviation"] < 0.05)
+
+
+class Bowl:
+    """y = c + k ((mu_s - 0.55)^2 + (mu_r - 0.55)^2): the sets matching one y form a ring."""
+
+    def __init__(self, const, k):
+        self.c, self.k = const, k
+
+    def predict_torch(self, X):
+        return self.c + self.k * ((X[:, 0] - 0.55) ** 2 + (X[:, 1] - 0.55) ** 2)
+
+
+def test_a_mean_outside_a_curved_valid_region_is_named(tmp_path):
+    # A measured angle of 40 deg matched on a ring of radius 0.3 about (0.55, 0.55): the ring's
+    # valid sets average to its centre, where the surrogate predicts 30 deg.
+    features = ["coefficientFriction", "coefficientRollingFriction"]
+    exp = Experiment("m", "", [], angle_of_repose=40.0)
+    screening = {
+        "axes": {
+            "coefficientFriction": [0.1, 1.0, 91],
+            "coefficientRollingFriction": [0.1, 1.0, 91],
+        },
+        "seed": 1,
+        "tolerance": 0.05,
+        "chunk_size": 1024,
+        "threads": 1,
+    }
+    result = calibrate({"aor": (Bowl(30.0, 10.0 / 0.09), features)}, exp, screening, {})
+    mean = result.identified
+    assert mean["coefficientFriction"]["mean"] == pytest.approx(0.55, abs=0.05)
+    (row,) = result.at_identified
+    assert row["predicted"] == pytest.approx(30.0, abs=1.0) and not row["within_tolerance"]
+    line = mean_set_statement(result.at_identified, 0.05)
+    assert line.startswith("**The identified mean set is not itself a valid set**")
+    assert (
+        f"aor {row['predicted']:.4g} against 40 ({row['deviation']:.1%} off)" in line
+        and "\n" not in line
+    )
+    assert mean_set_statement([{**row, "within_tolerance": True}], 0.05).startswith(
+        "At the identified mean set the surrogates predict every measured value within the 5%"
+    )
 
 
 def test_valid_sets_written_read_back_to_six_digits(tmp_path):
@@ -478,3 +531,38 @@ def test_write_verification_table_lists_engines_and_failed_runs(tmp_path):
     assert "- liggghts: `liggghts -in {deck}`, 2 thread(s)" in text
     assert "FAILED on bundled: shear_cell identified_s1 (ERROR: unstable)" in text
     assert pd.read_csv(tmp_path / "v.csv").shape == table.shape
+    assert "surrogate" not in table  # no identified-set record given
+
+
+def test_verification_table_shows_the_surrogates_at_the_verified_set(tmp_path):
+    experiment = ROOT_DIR / "config" / "experiments" / "sinter_fines.yaml"
+    bulk = tmp_path / "bulk.csv"
+    pd.DataFrame(
+        [
+            {"test": "shear_cell", "case_id": "identified_s3", "normal_stress": 10070.0, "P": 1.0}
+            | {"rho_b": 1738.0, "status": "ok"},
+            {"test": "angle_of_repose", "case_id": "identified", "aor": 35.8, "status": "ok"},
+        ]
+    ).to_csv(bulk, index=False)
+    record = tmp_path / "identified.json"
+    predicted = [
+        {"observable": "rho_b", "normal_stress": 10070.0, "P": 1.0, "predicted": 1745.2},
+        {"observable": "aor", "normal_stress": None, "P": None, "predicted": 34.94},
+    ]
+    record.write_text(
+        json.dumps({"reach": "REACH LINE", "mean_set": "MEAN LINE", "predicted_at_mean": predicted})
+    )
+    table = write_verification_table(
+        {"configured": [bulk]},
+        experiment,
+        0.05,
+        tmp_path / "v.csv",
+        tmp_path / "v.md",
+        identified=record,
+    )
+    rows = table.set_index("observable")
+    assert (rows.loc["rho_b", "surrogate"], rows.loc["aor", "surrogate"]) == (1745.2, 34.94)
+    assert rows.loc["aor", "dem_configured"] == 35.8
+    text = (tmp_path / "v.md").read_text().splitlines()
+    assert text[:4] == ["REACH LINE", "", "MEAN LINE", ""]
+    assert any(line.startswith("surrogate: the surrogates' prediction") for line in text)

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import yaml
 
 from demcal.core.experiments import load_experiment
-from demcal.identification.reachability import reach_of_measurements, reach_statement
+from demcal.identification.reachability import edge_runs, reach_of_measurements, reach_statement
 
 DATA = pd.DataFrame(
     {
@@ -77,3 +78,46 @@ def test_a_condition_without_runs_is_not_reachable(tmp_path: Path) -> None:
     reach = reach_of_measurements(no_aor, experiment(tmp_path, 1700.0, 30.0), tol=0.05)
     assert reach[1].n_runs == 0 and not reach[1].reachable
     assert "no DEM run of the design has a value" in reach_statement(reach, "x")
+
+
+def heap_data(above: list[float]) -> pd.DataFrame:
+    """The shear runs of DATA and 64 heaps: 9-38 deg, then ``above``."""
+    heaps = [*np.linspace(9.0, 38.0, 64 - len(above)).tolist(), *above]
+    aor = pd.DataFrame({"test": "angle_of_repose", "aor": heaps})
+    return pd.concat([DATA[DATA["test"] == "shear_cell"], aor], ignore_index=True)
+
+
+def test_a_value_only_a_few_runs_reach_lies_at_the_edge(tmp_path: Path) -> None:
+    # 64 heaps as in the default study: the sinter fines' 38.85 deg with two heaps above it
+    # (39.3, 39.5: one seed's scatter) is at the edge; with four above (6 %) it is inside.
+    measured = experiment(tmp_path, 1700.0, 38.85)
+    reach = reach_of_measurements(heap_data([39.3, 39.5]), measured, tol=0.05)
+    aor = reach[1]
+    assert (aor.n_runs, aor.n_beyond, aor.above, aor.reachable, aor.inside) == (
+        64,
+        2,
+        True,
+        True,
+        False,
+    )
+    line = reach_statement(reach, "test fines")
+    assert line.startswith("**The measurement of test fines lies at the edge")
+    assert "aor (angle of repose) measured 38.85, above 62 of the 64 DEM runs" in line
+    more = reach_of_measurements(heap_data([39.0, 39.1, 39.3, 39.5]), measured, tol=0.05)
+    assert more[1].n_beyond == 4 and more[1].inside
+    assert reach_statement(more, "test fines").startswith("Every measured value")
+
+
+def test_the_far_side_of_a_low_value_is_below_it(tmp_path: Path) -> None:
+    # rho_b 1655 lies below the median of 1650 / 1720 with one run below it: inside for two runs.
+    reach = reach_of_measurements(DATA, experiment(tmp_path, 1655.0, 30.0), tol=0.05)
+    assert (reach[0].above, reach[0].n_beyond, reach[0].inside) == (False, 1, True)
+    below = reach_of_measurements(DATA, experiment(tmp_path, 1600.0, 30.0), tol=0.05)
+    assert (below[0].n_beyond, below[0].inside, below[0].reachable) == (0, False, True)
+    assert "rho_b (normal_stress=10070,P=1) measured 1600, below every DEM run" in reach_statement(
+        below, "x"
+    )
+
+
+def test_the_edge_needs_five_per_cent_of_the_runs() -> None:
+    assert [edge_runs(n) for n in (1, 12, 20, 21, 64, 100)] == [1, 1, 1, 2, 4, 5]

@@ -180,6 +180,13 @@ def test_outputs_hold_the_study(study):
     assert fig11.shape == (630, 1650, 3)
 
 
+def _inside_runs(values: pd.Series, measured: float) -> bool:
+    """At least 5 % of the finite runs (and at least one) beyond ``measured`` on its far side."""
+    v = values.dropna()
+    beyond = (v > measured).sum() if measured > v.median() else (v < measured).sum()
+    return bool(len(v)) and beyond >= max(1, int(np.ceil(0.05 * len(v))))
+
+
 def test_identification_recovers_synthetic_truth(study):
     """The report says first whether the design reaches the measurement; when it does, the
     identification uses the sets valid for both tests. Whether those hold the truth, and narrow
@@ -198,7 +205,8 @@ def test_identification_recovers_synthetic_truth(study):
         (study / "results" / "identification" / "identified_parameters.json").read_text()
     )
     # Can the design reach the measurement at all? Computed here from the dataset: every measured
-    # value within the range of its DEM runs, widened by the 5 % tolerance.
+    # value within the range of its DEM runs, widened by the 5 % tolerance; inside the runs when
+    # at least 5 % of them (and at least one) lie beyond it.
     config = load_config(study / "config.yaml")
     experiment = Path(config["experiment"])
     experiment = experiment if experiment.is_absolute() else study / experiment
@@ -211,10 +219,10 @@ def test_identification_recovers_synthetic_truth(study):
             if key in cond:
                 lo, hi = rows[key].min(), rows[key].max()
                 reach.append(0.95 * lo <= cond[key] <= 1.05 * hi)
-                inside.append(lo <= cond[key] <= hi)
+                inside.append(_inside_runs(rows[key], cond[key]))
     aor = data.loc[data["test"] == "angle_of_repose", "aor"]
     reach.append(0.95 * aor.min() <= measured["angle_of_repose"]["value"] <= 1.05 * aor.max())
-    inside.append(aor.min() <= measured["angle_of_repose"]["value"] <= aor.max())
+    inside.append(_inside_runs(aor, measured["angle_of_repose"]["value"]))
     first_line = (study / "results" / "identification" / "table5.md").read_text().splitlines()[0]
     assert identified["reachable"] == all(reach), (reach, first_line)
     if not all(reach):
