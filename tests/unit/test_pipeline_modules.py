@@ -184,6 +184,11 @@ def test_load_experiment_partial_and_invalid(tmp_path):
         load_experiment(bad)
 
 
+def screening_section(axes: dict) -> dict:
+    """A screening config section over ``axes`` (name -> [low, high, count]), 5 % tolerance."""
+    return {"axes": axes, "seed": 1, "tolerance": 0.05, "chunk_size": 1024, "threads": 1}
+
+
 class Linear:
     """An exact analytic 'surrogate' y = c + w . x (torch, original units)."""
 
@@ -226,18 +231,14 @@ def test_calibration_recovers_truth_with_analytic_surrogates():
         ],
         angle_of_repose=10 + 6 + 12,
     )
-    screening = {
-        "axes": {
+    screening = screening_section(
+        {
             "coefficientFriction": [0.1, 1.0, 60],
             "coefficientRollingFriction": [0.1, 1.0, 60],
             "coefficientRestitution": [0.5, 0.9, 3],
             "density": [2500, 3500, 25],
-        },
-        "seed": 1,
-        "tolerance": 0.05,
-        "chunk_size": 1024,
-        "threads": 1,
-    }
+        }
+    )
     surrogates = {
         "mu_psh": (mu_psh, features),
         "rho_b": (rho_b, features),
@@ -288,16 +289,12 @@ def test_a_mean_outside_a_curved_valid_region_is_named(tmp_path):
     # valid sets average to its centre, where the surrogate predicts 30 deg.
     features = ["coefficientFriction", "coefficientRollingFriction"]
     exp = Experiment("m", "", [], angle_of_repose=40.0)
-    screening = {
-        "axes": {
+    screening = screening_section(
+        {
             "coefficientFriction": [0.1, 1.0, 91],
             "coefficientRollingFriction": [0.1, 1.0, 91],
-        },
-        "seed": 1,
-        "tolerance": 0.05,
-        "chunk_size": 1024,
-        "threads": 1,
-    }
+        }
+    )
     result = calibrate({"aor": (Bowl(30.0, 10.0 / 0.09), features)}, exp, screening, {})
     mean = result.identified
     assert mean["coefficientFriction"]["mean"] == pytest.approx(0.55, abs=0.05)
@@ -342,13 +339,7 @@ def test_valid_sets_written_read_back_to_six_digits(tmp_path):
 def test_calibration_names_unscreened_varying_input():
     model = Linear([1.0, 1.0], 0.0)
     exp = Experiment("m", "", [], angle_of_repose=1.0)
-    screening = {
-        "axes": {"coefficientFriction": [0.1, 1.0, 3]},
-        "seed": 1,
-        "tolerance": 0.05,
-        "chunk_size": 1024,
-        "threads": 1,
-    }
+    screening = screening_section({"coefficientFriction": [0.1, 1.0, 3]})
     with pytest.raises(ValueError, match="wallFriction"):
         calibrate({"aor": (model, ["coefficientFriction", "wallFriction"])}, exp, screening, {})
 
