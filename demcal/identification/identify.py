@@ -97,14 +97,14 @@ def identify(
     experiment = load_experiment(experiment_file)
     result = calibrate(surrogates, experiment, screening, constants)
     write_valid_sets(result, Path(files.table5).parent)
+    tol = float(screening["tolerance"])
     reach = None
     if dataset is not None:
-        tol = float(screening["tolerance"])
         reach = reach_of_measurements(pd.read_csv(dataset), experiment, tol)
     statement = reach_statement(reach, experiment.material) + "\n\n" if reach else ""
-    if result.at_identified:
-        tol = float(screening["tolerance"])
-        statement += mean_set_statement(result.at_identified, tol) + "\n\n"
+    mean_line = mean_set_statement(result.at_identified, tol) if result.at_identified else ""
+    if mean_line:
+        statement += mean_line + "\n\n"
     text = statement + (
         f"# Table 5: valid parameter sets for {experiment.material}\n\n"
         f"{result.n_total} candidate sets screened in {result.elapsed_s:.2f} s; tolerance "
@@ -123,7 +123,7 @@ def identify(
     if result.at_identified:
         record["predicted_at_mean"] = result.at_identified
         record["mean_accepted"] = all(r["within_tolerance"] for r in result.at_identified)
-        record["mean_set"] = mean_set_statement(result.at_identified, float(screening["tolerance"]))
+        record["mean_set"] = mean_line
     if reach is not None:
         record["reachable"] = all(r.reachable for r in reach)
         record["reach"] = reach_statement(reach, experiment.material)
