@@ -221,15 +221,15 @@ def restrict_levels(factor: Factor, values: Sequence[float]) -> Factor:
         When a value is not a level of the factor; the message lists its levels.
     """
     known = [factor.level_value(level) for level in factor.levels]
-    unknown = [v for v in values if not any(abs(v - k) <= 1e-9 * max(1.0, abs(k)) for k in known)]
+    unknown = [v for v in values if not any(math.isclose(v, k, rel_tol=1e-9) for k in known)]
     if unknown:
         raise ValueError(
             f"factor {factor.name}: {unknown} are not among its levels {[f'{k:g}' for k in known]}"
         )
     kept = tuple(
         level
-        for level in factor.levels
-        if any(abs(factor.level_value(level) - v) <= 1e-9 * max(1.0, abs(v)) for v in values)
+        for level, k in zip(factor.levels, known, strict=True)
+        if any(math.isclose(v, k, rel_tol=1e-9) for v in values)
     )
     return replace(factor, levels=kept)
 

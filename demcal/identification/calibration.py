@@ -5,6 +5,7 @@ repose alone (AoR), and both (shear-cell conditions, then AoR on the marked sets
 """
 
 import gzip
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
@@ -25,6 +26,7 @@ from demcal.identification.statistics import (
     identified_parameters,
     valid_set_statistics,
 )
+from demcal.identification.verification import measured_observations
 
 GROUPS = ("SSC", "AoR", "SSC & AoR")
 
@@ -104,30 +106,31 @@ def predictions_at(
         ``normal_stress`` (Pa) and ``P`` (None for the angle of repose), ``measured``,
         ``predicted``, ``deviation`` (|1 - predicted / measured|) and ``within_tolerance``.
     """
-    checks = [(c.values, c.load) for c in experiment.shear_conditions]
-    if experiment.angle_of_repose is not None:
-        checks.append(({"aor": experiment.angle_of_repose}, {}))
     out: list[dict[str, Any]] = []
-    for values, load in checks:
+    for obs in measured_observations(experiment):
+        name, measured = obs["observable"], float(obs["measured"])
+        if name not in predictors:
+            continue
+        load = {
+            k: float(obs[k])
+            for k in ("normal_stress", "P")
+            if obs[k] is not None and math.isfinite(obs[k])
+        }
         inputs = {**point, **load}
-        for name, measured in values.items():
-            if name not in predictors:
-                continue
-            model, free = predictors[name]
-            x = np.array([[float(inputs[f]) for f in free]])
-            predicted = float(model.predict(x)[0])
-            accepted = within_tolerance({name: np.array([predicted])}, {name: measured}, tol)
-            out.append(
-                {
-                    "observable": name,
-                    "normal_stress": load.get("normal_stress"),
-                    "P": load.get("P"),
-                    "measured": float(measured),
-                    "predicted": predicted,
-                    "deviation": float(relative_deviation(predicted, measured)),
-                    "within_tolerance": bool(accepted[0]),
-                }
-            )
+        model, free = predictors[name]
+        predicted = float(model.predict(np.array([[float(inputs[f]) for f in free]]))[0])
+        accepted = within_tolerance({name: np.array([predicted])}, {name: measured}, tol)
+        out.append(
+            {
+                "observable": name,
+                "normal_stress": load.get("normal_stress"),
+                "P": load.get("P"),
+                "measured": measured,
+                "predicted": predicted,
+                "deviation": float(relative_deviation(predicted, measured)),
+                "within_tolerance": bool(accepted[0]),
+            }
+        )
     return out
 
 

@@ -26,8 +26,11 @@ def scatter_columns(engine: str) -> tuple[str, str]:
     return f"dem_sd_{engine}", f"runs_{engine}"
 
 
-def _observations(experiment: Experiment) -> list[dict]:
-    """The measured observables in table order: name, load, measured value and sd."""
+def measured_observations(experiment: Experiment) -> list[dict]:
+    """The measured observables in table order: name, load, measured value and sd.
+
+    The angle of repose has no load: its ``normal_stress`` and ``P`` are NaN.
+    """
     rows = []
     for cond in experiment.shear_conditions:
         for name, measured in cond.values.items():
@@ -102,7 +105,7 @@ def verification_table(
     """
     if not runs:
         raise ValueError("no engine: nothing to verify")
-    rows = _observations(experiment)
+    rows = measured_observations(experiment)
     for row in rows:
         values = []
         for engine, frame in runs.items():
