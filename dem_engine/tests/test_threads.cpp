@@ -1,7 +1,10 @@
 // Tests of how work is split between threads (the particle partition, balanced by the contacts
 // the neighbour list marks as touching at a build) and of the contact histories a neighbour
 // build keeps.
+#include <cmath>
 #include <cstddef>
+#include <set>
+#include <utility>
 #include <vector>
 
 #include "contact/contact_types.h"
@@ -122,4 +125,61 @@ TEST_CASE("neighbour list: after a reordering, histories follow the tags and the
   CHECK_EQ(static_cast<int>(list.touching[1]), 1);  // 2-1
   CHECK_EQ(list.history[0], 0.0);
   CHECK_EQ(list.history[dem::kHistorySize], -1e-6);
+}
+
+TEST_CASE("neighbour list: a bin with more candidates than the scan buffer finds every pair") {
+  // One big sphere makes the bins 2 x 5 mm wide; 900 small ones fill one, so its stencil holds
+  // far more candidates than the search's stack buffer and takes its other path.
+  dem::Particles p;
+  dem::Domain box;
+  box.boundary = {'f', 'f', 'f'};
+  box.lo = Vec3{-1, -1, -1};
+  box.hi = Vec3{1, 1, 1};
+  p.add(1, 1, 1u, Vec3{0.0, 0.0, 0.0}, 0.005, 2500.0);
+  for (int k = 0; k < 900; ++k) {
+    const double s = static_cast<double>(k);
+    p.add(k + 2, 1, 1u, 0.006 * Vec3{std::sin(1.7 * s), std::cos(2.3 * s), std::sin(0.37 * s)},
+          0.0004, 2500.0);
+  }
+  dem::NeighborList list;
+  list.skin = 0.0002;
+  list.build(p, box);
+  std::set<std::pair<int, int>> found, expected;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (int k = list.first[i]; k < list.first[i + 1]; ++k)
+      found.insert({static_cast<int>(i), list.partner[k]});
+    for (std::size_t j = i + 1; j < p.size(); ++j) {
+      const double reach = p.radius[i] + p.radius[j] + list.skin;
+      if (dem::norm2(p.x[i] - p.x[j]) < reach * reach)
+        expected.insert({static_cast<int>(i), static_cast<int>(j)});
+    }
+  }
+  CHECK(expected.size() > 900);
+  CHECK(found == expected);
+  CHECK_EQ(list.pairs(), expected.size());
+}
+
+TEST_CASE("neighbour list: a particle added with a reordering starts without history") {
+  dem::Particles p;
+  dem::Domain box;
+  box.boundary = {'f', 'f', 'f'};
+  box.lo = Vec3{-1, -1, -1};
+  box.hi = Vec3{1, 1, 1};
+  p.add(1, 1, 1u, Vec3{0.0, 0.0, 0.0}, 0.01, 2500.0);
+  p.add(2, 1, 1u, Vec3{0.019, 0.0, 0.0}, 0.01, 2500.0);
+  dem::NeighborList list;
+  list.skin = 0.002;
+  list.build(p, box);
+  CHECK_EQ(list.pairs(), std::size_t{1});
+  list.history[0] = 1e-6;  // 1-2
+  // Tag 3 arrives touching particle 1, and the order changes: tags 2, 3, 1.
+  p.add(3, 1, 1u, Vec3{0.0, 0.019, 0.0}, 0.01, 2500.0);
+  p.permute({1, 2, 0});
+  list.build(p, box);
+  // Pairs by index: (0, 2) is tags 2-1, (1, 2) is tags 3-1; 2 and 3 are apart.
+  CHECK_EQ(list.pairs(), std::size_t{2});
+  CHECK_EQ(list.partner[0], 2);
+  CHECK_EQ(list.partner[1], 2);
+  CHECK_EQ(list.history[0], -1e-6);  // seen from particle 2 now: the sign flips
+  CHECK_EQ(list.history[dem::kHistorySize], 0.0);
 }

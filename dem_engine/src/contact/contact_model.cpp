@@ -315,7 +315,9 @@ class ComposedModel final : public ContactModel {
   void loop(PairForceArgs& a) const {
     Particles& P = a.atoms;
     const std::size_t n = P.size();
-    const int nthreads = static_cast<int>(a.thread_force.size());  // 1 for small systems
+    const int nthreads = worker_threads(n);  // 1 for small systems
+    PairScratch& scratch = a.scratch;
+    scratch.size_for(n, nthreads);
     ContactStep step;
     step.options = spec().options;
     step.dt = a.dt;
@@ -328,9 +330,7 @@ class ComposedModel final : public ContactModel {
 #pragma omp parallel num_threads(nthreads) reduction(+ : contacts)
     {
       // Each thread takes the pairs of its own share of particles (the list's partition, as
-      // every per-particle loop does). Thread 0 adds straight into the particle arrays, the others
-      // into buffers, from the start of their share up to their largest partner index, that
-      // are summed in below: one thread needs neither buffers nor a reduction.
+      // every per-particle loop does); see PairScratch for how the shares exchange data.
       const int tid = omp_get_thread_num();
       const int team = omp_get_num_threads();  // may be fewer than asked for
       // Array pointers as locals of each thread, not shared variables of the parallel region:
@@ -347,14 +347,15 @@ class ComposedModel final : public ContactModel {
         if (first[i + 1] > first[i])
           end_j = std::max(end_j, static_cast<std::size_t>(partner[first[i + 1] - 1]) + 1);
       touched_end[static_cast<std::size_t>(tid)] = end_j;
-      Vec3* f = tid == 0 ? P.f.data() : a.thread_force[tid].data();
-      Vec3* t = tid == 0 ? P.torque.data() : a.thread_torque[tid].data();
-      std::fill(P.f.data() + own.begin, P.f.data() + own.end, Vec3{});
-      std::fill(P.torque.data() + own.begin, P.torque.data() + own.end, Vec3{});
-      if (tid != 0) {
-        std::fill(f + own.begin, f + end_j, Vec3{});
-        std::fill(t + own.begin, t + end_j, Vec3{});
-      }
+      const std::size_t own_end = own.end;
+      Vec3* const f = P.f.data();
+      Vec3* const t = P.torque.data();
+      Vec3* const f_out = end_j > own.end ? scratch.force[tid].data() : f;
+      Vec3* const t_out = end_j > own.end ? scratch.torque[tid].data() : t;
+      std::fill(f + own.begin, f + own.end, Vec3{});
+      std::fill(t + own.begin, t + own.end, Vec3{});
+      std::fill(f_out + own.end, f_out + end_j, Vec3{});
+      std::fill(t_out + own.end, t_out + end_j, Vec3{});
       // Contacts are gathered across particles into batches (pass 1), whose contact laws run
       // kLanes contacts at a time on packs (pass 2); their forces are then added in the order
       // of the list (pass 3), so the sums are those of one contact at a time.
@@ -381,11 +382,14 @@ class ComposedModel final : public ContactModel {
           const double ri = rad[i];
           for (; h < size && bi[h] == i; ++h) {
             const int j = bj[h];
+            const bool inside = static_cast<std::size_t>(j) < own_end;
+            Vec3* const fj = (inside ? f : f_out) + j;
+            Vec3* const tj = (inside ? t : t_out) + j;
             const Vec3 force{out[0][h], out[1][h], out[2][h]};
             fi += force;
-            f[j] -= force;
+            *fj -= force;
             ti += Vec3{out[3][h], out[4][h], out[5][h]};
-            t[j] += Vec3{out[6][h], out[7][h], out[8][h]};
+            *tj += Vec3{out[6][h], out[7][h], out[8][h]};
             const double rmin = std::min(ri, rad[j]);
             const double overlap = out[9][h];
             if (overlap > my_ratio * rmin) {
@@ -398,7 +402,6 @@ class ComposedModel final : public ContactModel {
         }
         batch.size = 0;
       };
-#pragma omp barrier
       for (std::size_t i = own.begin; i < own.end; ++i) {
         int k = first[i];
         const int k_end = first[i + 1];
@@ -438,19 +441,24 @@ class ComposedModel final : public ContactModel {
         worst_ratio = my_ratio;
         worst_tag = my_tag;
       }
-      // Fixed-order reduction: the sum over threads does not depend on scheduling.
       if (team > 1) {
+        // Every thread adds the sums of the earlier threads on its own particles, in thread
+        // order: the sum over threads does not depend on scheduling.
 #pragma omp barrier
-        for (std::size_t i = own.begin; i < own.end; ++i) {
+        // Only the earlier threads add into this share, and only up to their largest partner.
+        std::size_t reach = own.begin;
+        for (int th = 0; th < tid; ++th)
+          reach = std::max(reach, touched_end[static_cast<std::size_t>(th)]);
+        reach = std::min(reach, own.end);
+        for (std::size_t i = own.begin; i < reach; ++i) {
           Vec3 fs, ts;
-          // Shares are ordered: only threads up to this one start at or before i.
-          for (int th = 1; th <= tid; ++th) {
+          for (int th = 0; th < tid; ++th) {
             if (i >= touched_end[static_cast<std::size_t>(th)]) continue;
-            fs += a.thread_force[th][i];
-            ts += a.thread_torque[th][i];
+            fs += scratch.force[th][i];
+            ts += scratch.torque[th][i];
           }
-          P.f[i] += fs;
-          P.torque[i] += ts;
+          f[i] += fs;
+          t[i] += ts;
         }
       }
     }
@@ -461,6 +469,14 @@ class ComposedModel final : public ContactModel {
 };
 
 }  // namespace
+
+void PairScratch::size_for(std::size_t n, int nthreads) {
+  const auto team = static_cast<std::size_t>(std::max(nthreads, 1));
+  for (auto* per_thread : {&force, &torque}) {
+    per_thread->resize(team);
+    for (std::size_t t = 0; t + 1 < team; ++t) (*per_thread)[t].resize(n);
+  }
+}
 
 std::unique_ptr<ContactModel> make_contact_model(const ModelSpec& spec) {
   if (spec.cohesion_sjkr && spec.rolling_epsd2)

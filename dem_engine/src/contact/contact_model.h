@@ -32,6 +32,18 @@ bool parse_model_keyword(const std::vector<std::string>& words, std::size_t& pos
 // pair_style gran: the model types, then only model keywords.
 void parse_pair_model(const std::vector<std::string>& words, std::size_t pos, ModelSpec& spec);
 
+// Buffers of the parallel pair loop, kept between steps. A thread adds the forces of its pairs
+// on its own particles straight into the particle arrays; those on partners in later shares
+// (the list holds a pair under its lower index) it sums here, and the owners add them in. So
+// no core writes into the lines of another share's forces and torques, which that share's
+// thread zeroes, reads and integrates every step.
+struct PairScratch {
+  // [thread][particle] for every thread but the last: its sums on partners past its share.
+  std::vector<std::vector<Vec3>> force, torque;
+  // Sizes the buffers for n particles and a team of nthreads.
+  void size_for(std::size_t n, int nthreads);
+};
+
 struct PairForceArgs {
   Particles& atoms;
   NeighborList& list;
@@ -42,9 +54,7 @@ struct PairForceArgs {
   // Group bit of the first fix freeze (0 if none): a pair with a frozen particle has the
   // effective mass of the other particle, as in LIGGGHTS.
   std::uint32_t freeze_bit;
-  // [thread][particle] for threads >= 1 (thread 0 adds into atoms), zeroed by the callee
-  std::vector<std::vector<Vec3>>& thread_force;
-  std::vector<std::vector<Vec3>>& thread_torque;
+  PairScratch& scratch;
   double max_overlap_ratio = 0.0;  // out: largest overlap / smaller radius
   long max_overlap_tag = -1;       // out: tag of a particle in that contact
   long contacts = 0;               // out: touching pairs

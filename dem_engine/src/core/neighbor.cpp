@@ -30,18 +30,8 @@ bool NeighborList::due(const Particles& p, long steps_since_build) const {
 
 namespace {
 
-struct OldContact {
-  std::uint64_t key;
-  bool swapped;  // stored as (larger tag, smaller tag)
-  std::array<double, kHistorySize> hist;
-};
-
-std::uint64_t pair_key(std::int64_t a, std::int64_t b, bool& swapped) {
-  swapped = a > b;
-  const auto lo = static_cast<std::uint64_t>(swapped ? b : a);
-  const auto hi = static_cast<std::uint64_t>(swapped ? a : b);
-  return (lo << 32) ^ hi;
-}
+// Candidates of one bin's stencil scanned through a stack buffer (see NeighborList::build).
+constexpr int kScanBuffer = 512;
 
 bool any_nonzero(const double* hist) {
   for (int c = 0; c < kHistorySize; ++c)
@@ -102,40 +92,42 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   const std::size_t n = p.size();
   // Contact history transfer: when the particle order is unchanged since the last build, the
   // old and new partner lists of each particle are both sorted, so a linear merge matches them;
-  // otherwise contacts are matched through their tags.
+  // otherwise contacts are matched through the tags of their particles. All histories are
+  // carried over here; mark_touching then keeps only those of the pairs that touch at the
+  // positions of this build (see there).
   const bool same_order = tags_at_build_ == p.tag;
-  std::vector<OldContact> old;
-  std::vector<int> old_first, old_partner;
-  std::vector<double> old_history;
-  // All histories are carried over here; mark_touching then keeps only those of the pairs that
-  // touch at the positions of this build (see there).
-  if (same_order) {
-    old_first.swap(first);
-    old_partner.swap(partner);
-    old_history.swap(history);
-  } else {
-    for (std::size_t i = 0; i + 1 < first.size(); ++i) {
-      for (int k = first[i]; k < first[i + 1]; ++k) {
-        const double* h = &history[static_cast<std::size_t>(k) * kHistorySize];
-        if (!any_nonzero(h)) continue;
-        OldContact oc;
-        oc.key = pair_key(tags_at_build_[i], tags_at_build_[partner[k]], oc.swapped);
-        std::copy(h, h + kHistorySize, oc.hist.begin());
-        old.push_back(oc);
-      }
+  // The previous list moves to the spare arrays and the new one is built in the storage of the
+  // one before: no build allocates (and page-faults in) a fresh history array.
+  spare_first_.swap(first);
+  spare_partner_.swap(partner);
+  spare_history_.swap(history);
+  const std::vector<int>& old_first = spare_first_;
+  const std::vector<int>& old_partner = spare_partner_;
+  const std::vector<double>& old_history = spare_history_;
+  // After a reordering (or particles added, removed or renumbered): each particle's index at
+  // the last build, found through its tag (-1: not there then).
+  std::vector<int> old_index;
+  if (!same_order) {
+    std::vector<std::pair<std::int64_t, int>> by_tag;
+    by_tag.reserve(tags_at_build_.size());
+    for (std::size_t i = 0; i < tags_at_build_.size() && i + 1 < old_first.size(); ++i)
+      if (tags_at_build_[i] != 0) by_tag.emplace_back(tags_at_build_[i], static_cast<int>(i));
+    std::sort(by_tag.begin(), by_tag.end());
+    old_index.assign(n, -1);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto it = std::lower_bound(by_tag.begin(), by_tag.end(),
+                                       std::pair<std::int64_t, int>{p.tag[i], -1});
+      if (it != by_tag.end() && it->first == p.tag[i]) old_index[i] = it->second;
     }
-    std::sort(old.begin(), old.end(),
-              [](const OldContact& a, const OldContact& b) { return a.key < b.key; });
   }
-
   first.assign(n + 1, 0);
-  partner.clear();
-  history.clear();
   x_at_build_ = p.x;
   tags_at_build_ = p.tag;
   forced_ = false;
   ++builds_;
   if (n == 0) {
+    partner.clear();
+    history.clear();
     mark_touching(p, domain, 1);
     return;
   }
@@ -217,20 +209,35 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
           runs[nruns][1] = start[row + x_hi + 1];
           ++nruns;
         }
+      int candidates = 0;
+      for (int r = 0; r < nruns; ++r) candidates += runs[r][1] - runs[r][0];
+      // Partners are first written to a local buffer without branching on the two coin-flip
+      // tests (index order and distance): every candidate is stored, and the count advances
+      // only for a partner. A dense bin's stencil may exceed the buffer; then partners go
+      // to the vector one by one.
+      int buf[kScanBuffer];
+      const bool fits = candidates <= kScanBuffer;
       for (int s = start[b]; s < start[b + 1]; ++s) {
         const int i = items[s];
         const Vec3 xi = bx[s];
         const double ri = br[s] + skin;
         auto& out = found_[static_cast<std::size_t>(i)];
         out.clear();
+        int m = 0;
         for (int r = 0; r < nruns; ++r)
           for (int t = runs[r][0]; t < runs[r][1]; ++t) {
             const int j = items[t];
-            if (j <= i) continue;
             const Vec3 d = xi - bx[t];
             const double reach = ri + br[t];
-            if (norm2(d) < reach * reach) out.push_back(j);
+            const bool take = (j > i) & (norm2(d) < reach * reach);
+            if (fits) {
+              buf[m] = j;
+              m += take;
+            } else if (take) {
+              out.push_back(j);
+            }
           }
+        if (fits) out.assign(buf, buf + m);
         // Sorted partners give a deterministic pair order and allow the merge below.
         std::sort(out.begin(), out.end());
       }
@@ -283,13 +290,38 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
     }
   }
   for (std::size_t i = 0; i < n; ++i) first[i + 1] = first[i] + static_cast<int>(found_[i].size());
+  // Sized without clearing: every entry is written below, in parallel.
   partner.resize(static_cast<std::size_t>(first[n]));
-  history.assign(partner.size() * kHistorySize, 0.0);
+  history.resize(partner.size() * kHistorySize);
   const long ln = static_cast<long>(n);
 #pragma omp parallel for schedule(static) num_threads(nthreads)
   for (long i = 0; i < ln; ++i) {
     std::copy(found_[i].begin(), found_[i].end(), partner.begin() + first[i]);
-    if (!same_order || static_cast<std::size_t>(i) + 1 >= old_first.size()) continue;
+    std::fill(history.begin() + static_cast<std::ptrdiff_t>(first[i]) * kHistorySize,
+              history.begin() + static_cast<std::ptrdiff_t>(first[i + 1]) * kHistorySize, 0.0);
+    if (!same_order) {
+      const int oi = old_index[static_cast<std::size_t>(i)];
+      if (oi < 0) continue;
+      for (int k = first[i]; k < first[i + 1]; ++k) {
+        const int oj = old_index[static_cast<std::size_t>(partner[k])];
+        if (oj < 0) continue;
+        // The old list holds the pair under the lower of its two old indices.
+        const int lo = std::min(oi, oj), hi = std::max(oi, oj);
+        const auto from = old_partner.begin() + old_first[lo];
+        const auto to = old_partner.begin() + old_first[lo + 1];
+        const auto at = std::lower_bound(from, to, hi);
+        if (at == to || *at != hi) continue;
+        const double* h =
+            &old_history[static_cast<std::size_t>(at - old_partner.begin()) * kHistorySize];
+        if (!any_nonzero(h)) continue;
+        // History is oriented from the first to the second particle of the pair.
+        const double sign = oi < oj ? 1.0 : -1.0;
+        double* to_h = &history[static_cast<std::size_t>(k) * kHistorySize];
+        for (int c = 0; c < kHistorySize; ++c) to_h[c] = sign * h[c];
+      }
+      continue;
+    }
+    if (static_cast<std::size_t>(i) + 1 >= old_first.size()) continue;
     int a = old_first[i];
     const int a_end = old_first[i + 1];
     for (int k = first[i]; k < first[i + 1] && a < a_end; ++k) {
@@ -297,23 +329,6 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
       if (a < a_end && old_partner[a] == partner[k])
         std::copy_n(&old_history[static_cast<std::size_t>(a) * kHistorySize], kHistorySize,
                     &history[static_cast<std::size_t>(k) * kHistorySize]);
-    }
-  }
-  if (!same_order && !old.empty()) {
-#pragma omp parallel for schedule(static) num_threads(nthreads)
-    for (long i = 0; i < ln; ++i) {
-      for (int k = first[i]; k < first[i + 1]; ++k) {
-        bool swapped = false;
-        const std::uint64_t key = pair_key(p.tag[i], p.tag[partner[k]], swapped);
-        auto it = std::lower_bound(
-            old.begin(), old.end(), key,
-            [](const OldContact& a, std::uint64_t kk) { return a.key < kk; });
-        if (it == old.end() || it->key != key) continue;
-        // History is oriented from the first to the second particle of the pair.
-        const double sign = swapped == it->swapped ? 1.0 : -1.0;
-        double* h = &history[static_cast<std::size_t>(k) * kHistorySize];
-        for (int c = 0; c < kHistorySize; ++c) h[c] = sign * it->hist[c];
-      }
     }
   }
   mark_touching(p, domain, nthreads);

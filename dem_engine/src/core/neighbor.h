@@ -61,6 +61,9 @@ class NeighborList {
   std::vector<std::vector<int>> found_;  // partners per particle, reused between builds
   std::vector<Vec3> bin_x_;              // positions in bin order (build scratch)
   std::vector<double> bin_r_;            // radii in bin order (build scratch)
+  // The list before the last build (first, partner, history), kept for its storage.
+  std::vector<int> spare_first_, spare_partner_;
+  std::vector<double> spare_history_;
   bool forced_ = true;
   long builds_ = 0;
 };

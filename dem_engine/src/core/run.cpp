@@ -97,21 +97,14 @@ void Simulation::pair_forces() {
     std::fill(atoms.f.begin(), atoms.f.end(), Vec3{});
     std::fill(atoms.torque.begin(), atoms.torque.end(), Vec3{});
   } else {  // the pair forces overwrite f and torque
-    const int nthreads = worker_threads(n);
-    thread_force_.resize(nthreads);
-    thread_torque_.resize(nthreads);
-    for (int t = 1; t < nthreads; ++t) {  // thread 0 writes into atoms.f and atoms.torque
-      thread_force_[t].resize(n);
-      thread_torque_[t].resize(n);
-    }
     std::uint32_t freeze_bit = 0;
     for (const auto& f : fixes)
       if (f->style() == "freeze") {
         freeze_bit = f->group_bit();
         break;
       }
-    PairForceArgs args{atoms,        neighbor,   material,      domain,        dt,
-                       !setting_up_, freeze_bit, thread_force_, thread_torque_};
+    PairForceArgs args{atoms,        neighbor,   material,     domain, dt,
+                       !setting_up_, freeze_bit, pair_scratch_};
     pair->pair_forces(args);
     if (args.max_overlap_ratio > DeepOverlaps::kRatio)
       note_deep_overlap(args.max_overlap_ratio, args.max_overlap_tag, "a neighbour");

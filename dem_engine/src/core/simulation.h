@@ -123,7 +123,7 @@ class Simulation : public CommandHandler, public EvalContext {
   std::ofstream log_;
   std::chrono::steady_clock::time_point wall_start_;
   long last_build_step_ = 0;
-  std::vector<std::vector<Vec3>> thread_force_, thread_torque_;
+  PairScratch pair_scratch_;
   bool timestep_checked_ = false;
   bool setting_up_ = false;
   // `run ... pre no` skips the set-up only after an earlier run and when no particles were
