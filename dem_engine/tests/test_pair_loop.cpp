@@ -58,8 +58,10 @@ dem::Particles cluster(const std::vector<Vec3>& small_centres) {
 
 // Forces and torques after one force evaluation of the pair loop, on one thread (below 1 000
 // particles) or on up to `threads`; returns the list (with the histories the loop wrote).
+// The pair forces of `steps` steps on `threads` threads (same list; before each later step the
+// velocities and spins change, so that every step's forces depend on that step's values).
 dem::NeighborList evaluate(dem::Particles& p, const dem::MaterialTable& table, long& contacts,
-                           int threads = 1) {
+                           int threads = 1, int steps = 1) {
   const int before = omp_get_max_threads();
   omp_set_num_threads(threads);
   dem::Domain box;
@@ -74,7 +76,14 @@ dem::NeighborList evaluate(dem::Particles& p, const dem::MaterialTable& table, l
   const std::unique_ptr<dem::ContactModel> model = dem::make_contact_model(spec);
   dem::PairScratch scratch;
   dem::PairForceArgs args{p, list, table, box, 1e-5, true, 0u, scratch};
-  model->pair_forces(args);
+  for (int s = 0; s < steps; ++s) {
+    if (s > 0)
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        p.v[i] = Vec3{-p.v[i].y, p.v[i].x, 0.5 * p.v[i].z};
+        p.omega[i] = Vec3{p.omega[i].z, -p.omega[i].x, p.omega[i].y};
+      }
+    model->pair_forces(args);
+  }
   contacts = args.contacts;
   omp_set_num_threads(before);
   return list;
@@ -123,7 +132,7 @@ TEST_CASE("pair loop: a particle with more contacts than a batch holds gets thei
   CHECK(same(all.torque[0], torque_sum));
 }
 
-TEST_CASE("pair loop: two threads give the forces, torques and histories of one") {
+TEST_CASE("pair loop: two and three threads give the forces, torques and histories of one") {
   // A jittered cubic lattice of 14^3 spheres, 1 mm radius, 1.95 mm apart: each overlaps its
   // lattice neighbours, with velocities and spins that vary from particle to particle.
   const int side = 14;
@@ -141,30 +150,37 @@ TEST_CASE("pair loop: two threads give the forces, torques and histories of one"
         base.omega[i] = Vec3{3.0 * std::cos(s), -2.0 * std::sin(1.1 * s), std::cos(0.4 * s)};
       }
   const dem::MaterialTable table = material();
-  dem::Particles one = base, two = base;
-  long contacts_one = 0, contacts_two = 0;
-  const dem::NeighborList list_one = evaluate(one, table, contacts_one, 1);
-  const dem::NeighborList list_two = evaluate(two, table, contacts_two, 2);
+  // Three steps: a thread reads its partners in the next share from copies made each step.
+  const int steps = 3;
+  dem::Particles one = base;
+  long contacts_one = 0;
+  const dem::NeighborList list_one = evaluate(one, table, contacts_one, 1, steps);
   CHECK_EQ(contacts_one, 3L * side * side * (side - 1));  // the lattice neighbours
-  CHECK_EQ(contacts_two, contacts_one);
-  // Pairs across the two shares, whose forces the first thread hands to the second.
-  const dem::ParticleShare first_share = list_two.partition().share(base.size(), 0, 2);
-  int across = 0;
-  for (std::size_t i = first_share.begin; i < first_share.end; ++i)
-    for (int k = list_two.first[i]; k < list_two.first[i + 1]; ++k)
-      across += static_cast<std::size_t>(list_two.partner[k]) >= first_share.end;
-  CHECK(across > side * side);
-  // Forces differ only by the order of their sums: within a few roundings of the largest.
-  double f_max = 0.0, t_max = 0.0, f_diff = 0.0, t_diff = 0.0;
-  for (std::size_t i = 0; i < base.size(); ++i) {
-    f_max = std::max(f_max, dem::norm(one.f[i]));
-    t_max = std::max(t_max, dem::norm(one.torque[i]));
-    f_diff = std::max(f_diff, dem::norm(one.f[i] - two.f[i]));
-    t_diff = std::max(t_diff, dem::norm(one.torque[i] - two.torque[i]));
+  for (const int threads : {2, 3}) {
+    dem::Particles many = base;
+    long contacts_many = 0;
+    const dem::NeighborList list_many = evaluate(many, table, contacts_many, threads, steps);
+    CHECK_EQ(contacts_many, contacts_one);
+    // Pairs across the first two shares, whose partners the first thread reads from copies
+    // and whose forces it hands to the second.
+    const dem::ParticleShare first_share = list_many.partition().share(base.size(), 0, threads);
+    int across = 0;
+    for (std::size_t i = first_share.begin; i < first_share.end; ++i)
+      for (int k = list_many.first[i]; k < list_many.first[i + 1]; ++k)
+        across += static_cast<std::size_t>(list_many.partner[k]) >= first_share.end;
+    CHECK(across > side * side);
+    // Forces differ only by the order of their sums: within a few roundings of the largest.
+    double f_max = 0.0, t_max = 0.0, f_diff = 0.0, t_diff = 0.0;
+    for (std::size_t i = 0; i < base.size(); ++i) {
+      f_max = std::max(f_max, dem::norm(one.f[i]));
+      t_max = std::max(t_max, dem::norm(one.torque[i]));
+      f_diff = std::max(f_diff, dem::norm(one.f[i] - many.f[i]));
+      t_diff = std::max(t_diff, dem::norm(one.torque[i] - many.torque[i]));
+    }
+    CHECK(f_max > 0.0 && t_max > 0.0);
+    CHECK(f_diff <= 1e-14 * f_max);
+    CHECK(t_diff <= 1e-14 * t_max);
+    // The histories are per pair, not sums: the same bits.
+    CHECK(list_one.history == list_many.history);
   }
-  CHECK(f_max > 0.0 && t_max > 0.0);
-  CHECK(f_diff <= 1e-14 * f_max);
-  CHECK(t_diff <= 1e-14 * t_max);
-  // The histories are per pair, not sums: the same bits.
-  CHECK(list_one.history == list_two.history);
 }

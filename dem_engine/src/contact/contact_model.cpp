@@ -141,6 +141,12 @@ class ComposedModel final : public ContactModel {
   // pack. A fixed stride lets one register address every result column.
   static constexpr int kStride = kBatch + kLanes;
 
+  // Where a thread reads its partners j >= from: x[j - from] etc. (see PairScratch).
+  struct Ghosts {
+    std::size_t from;
+    const Vec3 *x, *v, *omega;
+  };
+
   // Touching pairs waiting for their contact law: particle i, its partner j, the list entry k,
   // and the results (force on i, torque on i, torque on j, overlap), one array per component
   // so that a pack of results is stored at once. Kept per thread between steps.
@@ -148,6 +154,7 @@ class ComposedModel final : public ContactModel {
     int i[kStride], j[kStride], k[kStride];
     alignas(32) double out[10][kStride];
     int size = 0;
+    bool ghosted = false;  // whether an entry's partner is read from the ghosts
     // The material parameters of the last pack, reused while the type pairs repeat (always,
     // with one particle type).
     const PairParams* params_of[kLanes] = {};
@@ -156,10 +163,10 @@ class ComposedModel final : public ContactModel {
 
   // The contact law of batch entries e0 .. e0 + count - 1 (count <= kLanes) in one pack; the
   // lanes past count repeat the last contact and are dropped. Packs are filled straight from
-  // the particle arrays.
-  template <bool Periodic>
+  // the particle arrays, and with Ghosted from the ghosts g for partners past the thread's share.
+  template <bool Periodic, bool Ghosted>
   DEM_AVX_CLONES void contact_pack(const PairForceArgs& a, const ContactStep& step, Batch& b,
-                                   int e0, int count) const {
+                                   const Ghosts& g, int e0, int count) const {
     const Particles& P = a.atoms;
     const Vec3* x = P.x.data();
     const Vec3* v = P.v.data();
@@ -183,15 +190,40 @@ class ComposedModel final : public ContactModel {
                lanes_of<Pack>([&](int l) { return of[idx[l]].y; }),
                lanes_of<Pack>([&](int l) { return of[idx[l]].z; })};
     };
+    // The partners' positions, velocities and spins.
+    V xj, vj, wj;
+    if constexpr (Ghosted) {
+      const Vec3 *px[kLanes], *pv[kLanes], *pw[kLanes];
+      for (int l = 0; l < kLanes; ++l) {
+        const bool ghost = jj[l] >= g.from;
+        const std::size_t at = ghost ? jj[l] - g.from : jj[l];
+        px[l] = (ghost ? g.x : x) + at;
+        pv[l] = (ghost ? g.v : v) + at;
+        pw[l] = (ghost ? g.omega : w) + at;
+      }
+      auto pack3_at = [&](const Vec3* const* of) {
+        return V{lanes_of<Pack>([&](int l) { return of[l]->x; }),
+                 lanes_of<Pack>([&](int l) { return of[l]->y; }),
+                 lanes_of<Pack>([&](int l) { return of[l]->z; })};
+      };
+      xj = pack3_at(px);
+      vj = pack3_at(pv);
+      wj = pack3_at(pw);
+    } else {
+      xj = pack3(x, jj);
+      vj = pack3(v, jj);
+      wj = pack3(w, jj);
+    }
     ContactInputT<Pack> c;
     V d;
     if constexpr (Periodic) {
       Vec3 dl[kLanes];
-      for (int l = 0; l < kLanes; ++l) dl[l] = a.domain.minimum_image(x[ii[l]] - x[jj[l]]);
+      for (int l = 0; l < kLanes; ++l)
+        dl[l] = a.domain.minimum_image(x[ii[l]] - Vec3{xj.x[l], xj.y[l], xj.z[l]});
       const std::size_t lane[kLanes] = {0, 1, 2, 3};
       d = pack3(dl, lane);
     } else {
-      d = pack3(x, ii) - pack3(x, jj);
+      d = pack3(x, ii) - xj;
     }
     const Pack r = lane_sqrt(norm2(d));
     c.ri = pack1(rad, ii);
@@ -216,9 +248,9 @@ class ComposedModel final : public ContactModel {
     c.m_eff = m_effective(mi, mj, a.freeze_bit != 0);
     c.cri = c.ri - 0.5 * c.overlap;
     c.crj = c.rj - 0.5 * c.overlap;
-    c.v_rel = pack3(v, ii) - pack3(v, jj);
+    c.v_rel = pack3(v, ii) - vj;
     c.omega_i = pack3(w, ii);
-    c.omega_j = pack3(w, jj);
+    c.omega_j = wj;
     const PairParams* q[kLanes];
     bool same = true;
     for (int l = 0; l < kLanes; ++l) {
@@ -317,7 +349,8 @@ class ComposedModel final : public ContactModel {
     const std::size_t n = P.size();
     const int nthreads = worker_threads(n);  // 1 for small systems
     PairScratch& scratch = a.scratch;
-    scratch.size_for(n, nthreads);
+    scratch.size_for(a.list, n, nthreads);
+    const long epoch = ++scratch.epoch;
     ContactStep step;
     step.options = spec().options;
     step.dt = a.dt;
@@ -342,12 +375,51 @@ class ComposedModel final : public ContactModel {
       const int* const partner = a.list.partner.data();
       std::uint8_t* const touching = a.list.touching.data();
       const ParticleShare own = a.list.partition().share(n, tid, team);
+      // Windows and ghosts hold for the team they were found for; when fewer threads start,
+      // each reads its partners from the particle arrays and finds its reach here.
+      const bool windows = team == scratch.team;
+      const auto me = static_cast<std::size_t>(tid);
       std::size_t end_j = own.end;
-      for (std::size_t i = own.begin; i < own.end; ++i)
-        if (first[i + 1] > first[i])
-          end_j = std::max(end_j, static_cast<std::size_t>(partner[first[i + 1] - 1]) + 1);
-      touched_end[static_cast<std::size_t>(tid)] = end_j;
+      if (windows) {
+        end_j = scratch.window_end[me];
+      } else {
+        for (std::size_t i = own.begin; i < own.end; ++i)
+          if (first[i + 1] > first[i])
+            end_j = std::max(end_j, static_cast<std::size_t>(partner[first[i + 1] - 1]) + 1);
+      }
+      touched_end[me] = end_j;
       const std::size_t own_end = own.end;
+      // Ghosts of this share's particles in the windows of the earlier threads.
+      if (windows && tid > 0) {
+        for (std::size_t th = 0; th < me; ++th) {
+          const std::size_t base = a.list.partition().share(n, static_cast<int>(th), team).end;
+          const std::size_t lo = std::max(base, own.begin);
+          const std::size_t hi = std::min(scratch.window_end[th], own.end);
+          for (std::size_t i = lo; i < hi; ++i) {
+            scratch.ghost_x[th][i - base] = x[i];
+            scratch.ghost_v[th][i - base] = P.v[i];
+            scratch.ghost_omega[th][i - base] = P.omega[i];
+          }
+        }
+        scratch.written[me].epoch.store(epoch, std::memory_order_release);
+      }
+      const Ghosts ghosts =
+          windows && end_j > own_end
+              ? Ghosts{own_end, scratch.ghost_x[me].data(), scratch.ghost_v[me].data(),
+                       scratch.ghost_omega[me].data()}
+              : Ghosts{n, nullptr, nullptr, nullptr};
+      const std::size_t cross_from = windows ? scratch.cross_from[me] : own.end;
+      const Vec3* const gx = ghosts.x;
+      // Waits for the owners of this thread's window to have written its ghosts (they do so
+      // first thing, and the window's pairs come last in this share: it hardly ever spins).
+      auto await_ghosts = [&] {
+        for (int th = tid + 1; th < team; ++th) {
+          if (a.list.partition().share(n, th, team).begin >= end_j) break;
+          while (scratch.written[static_cast<std::size_t>(th)].epoch.load(
+                     std::memory_order_acquire) != epoch) {
+          }
+        }
+      };
       Vec3* const f = P.f.data();
       Vec3* const t = P.torque.data();
       Vec3* const f_out = end_j > own.end ? scratch.force[tid].data() : f;
@@ -361,6 +433,7 @@ class ComposedModel final : public ContactModel {
       // of the list (pass 3), so the sums are those of one contact at a time.
       static thread_local Batch batch;
       batch.size = 0;
+      batch.ghosted = false;
       // The material table may have changed.
       std::fill(std::begin(batch.params_of), std::end(batch.params_of), nullptr);
       double my_ratio = 0.0;
@@ -372,8 +445,12 @@ class ComposedModel final : public ContactModel {
       const std::int64_t* const tag = P.tag.data();
       auto flush = [&]() {
         const int size = batch.size;
-        for (int h = 0; h < size; h += kLanes)
-          contact_pack<Periodic>(a, step, batch, h, std::min(kLanes, size - h));
+        for (int h = 0; h < size; h += kLanes) {
+          if (batch.ghosted)
+            contact_pack<Periodic, true>(a, step, batch, ghosts, h, std::min(kLanes, size - h));
+          else
+            contact_pack<Periodic, false>(a, step, batch, ghosts, h, std::min(kLanes, size - h));
+        }
         // The sums on i stay in registers while its contacts follow one another (partners
         // have j > i, so no other contact of the batch adds to f[i] meanwhile).
         for (int h = 0; h < size;) {
@@ -401,27 +478,40 @@ class ComposedModel final : public ContactModel {
           t[i] = ti;
         }
         batch.size = 0;
+        batch.ghosted = false;
       };
-      for (std::size_t i = own.begin; i < own.end; ++i) {
+      // Pass 1 sorts the listed pairs of particle i into touching ones and flags which touch
+      // (every one gathered here gets its contact law), without branching on the coin-flip
+      // condition. As in LIGGGHTS, the history of a pair that opened is kept while the pair
+      // stays in the list (a contact that closes again before the next neighbour build resumes
+      // it); the build drops it unless the pair touches at the build's positions (see
+      // NeighborList::build). A full batch is flushed, also between the pairs of one particle:
+      // its sums continue in the same order. With ghosts (the particles from cross_from on),
+      // partners past the share are read from them.
+      auto gather = [&](std::size_t i, auto with_ghosts) {
+        constexpr bool kGhosts = decltype(with_ghosts)::value;
         int k = first[i];
         const int k_end = first[i + 1];
-        if (k == k_end) continue;
+        if (k == k_end) return;
         const Vec3 xi = x[i];
         const double ri = rad[i];
-        // Pass 1 sorts the listed pairs into touching ones and flags which touch (every one
-        // gathered here gets its contact law), without branching on the coin-flip condition.
-        // As in LIGGGHTS, the history of a pair that opened is kept while the pair stays in
-        // the list (a contact that closes again before the next neighbour build resumes it);
-        // the build drops it unless the pair touches at the build's positions (see
-        // NeighborList::build). A full batch is flushed, also between the pairs of one
-        // particle: its sums continue in the same order.
+        if constexpr (kGhosts) batch.ghosted = true;
         while (k < k_end) {
-          if (batch.size == kBatch) flush();
+          if (batch.size == kBatch) {
+            flush();
+            if constexpr (kGhosts) batch.ghosted = true;
+          }
           const int stop = std::min(k_end, k + (kBatch - batch.size));
           int m = batch.size;
           for (; k < stop; ++k) {
             const int j = partner[k];
-            Vec3 d = xi - x[j];
+            Vec3 d = xi;
+            if constexpr (kGhosts) {
+              const auto uj = static_cast<std::size_t>(j);
+              d -= uj >= ghosts.from ? gx[uj - ghosts.from] : x[uj];
+            } else {
+              d -= x[j];
+            }
             if constexpr (Periodic) d = a.domain.minimum_image(d);
             const double radsum = ri + rad[j];
             const bool apart = norm2(d) >= radsum * radsum;
@@ -434,6 +524,11 @@ class ComposedModel final : public ContactModel {
           contacts += m - batch.size;
           batch.size = m;
         }
+      };
+      for (std::size_t i = own.begin; i < cross_from; ++i) gather(i, std::false_type{});
+      if (cross_from < own.end) {
+        await_ghosts();
+        for (std::size_t i = cross_from; i < own.end; ++i) gather(i, std::true_type{});
       }
       flush();
 #pragma omp critical
@@ -447,13 +542,12 @@ class ComposedModel final : public ContactModel {
 #pragma omp barrier
         // Only the earlier threads add into this share, and only up to their largest partner.
         std::size_t reach = own.begin;
-        for (int th = 0; th < tid; ++th)
-          reach = std::max(reach, touched_end[static_cast<std::size_t>(th)]);
+        for (std::size_t th = 0; th < me; ++th) reach = std::max(reach, touched_end[th]);
         reach = std::min(reach, own.end);
         for (std::size_t i = own.begin; i < reach; ++i) {
           Vec3 fs, ts;
-          for (int th = 0; th < tid; ++th) {
-            if (i >= touched_end[static_cast<std::size_t>(th)]) continue;
+          for (std::size_t th = 0; th < me; ++th) {
+            if (i >= touched_end[th]) continue;
             fs += scratch.force[th][i];
             ts += scratch.torque[th][i];
           }
@@ -470,11 +564,37 @@ class ComposedModel final : public ContactModel {
 
 }  // namespace
 
-void PairScratch::size_for(std::size_t n, int nthreads) {
-  const auto team = static_cast<std::size_t>(std::max(nthreads, 1));
-  for (auto* per_thread : {&force, &torque}) {
-    per_thread->resize(team);
-    for (std::size_t t = 0; t + 1 < team; ++t) (*per_thread)[t].resize(n);
+void PairScratch::size_for(const NeighborList& list, std::size_t n_now, int nthreads) {
+  const int size = std::max(nthreads, 1);
+  if (&list == list_of && list.builds() == list_build && n_now == n && size == team) return;
+  list_of = &list;
+  list_build = list.builds();
+  n = n_now;
+  team = size;
+  const auto t_count = static_cast<std::size_t>(team);
+  written = std::make_unique<Flag[]>(t_count);
+  window_end.assign(t_count, n);
+  cross_from.assign(t_count, n);
+  for (auto* per_thread : {&force, &torque, &ghost_x, &ghost_v, &ghost_omega})
+    per_thread->resize(t_count);
+  for (int t = 0; t < team; ++t) {
+    const auto tt = static_cast<std::size_t>(t);
+    const ParticleShare own = list.partition().share(n, t, team);
+    // Partners are sorted, so a particle's last one is its largest.
+    std::size_t end = own.end, from = own.end;
+    for (std::size_t i = own.begin; i < own.end; ++i) {
+      if (list.first[i + 1] == list.first[i]) continue;
+      const auto last = static_cast<std::size_t>(list.partner[list.first[i + 1] - 1]);
+      if (last >= own.end && from == own.end) from = i;
+      end = std::max(end, last + 1);
+    }
+    window_end[tt] = end;
+    cross_from[tt] = from;
+    if (t + 1 < team) {
+      force[tt].resize(n);
+      torque[tt].resize(n);
+    }
+    for (auto* ghost : {&ghost_x, &ghost_v, &ghost_omega}) (*ghost)[tt].resize(end - own.end);
   }
 }
 

@@ -1,4 +1,5 @@
 #pragma once
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -34,14 +35,33 @@ void parse_pair_model(const std::vector<std::string>& words, std::size_t pos, Mo
 
 // Buffers of the parallel pair loop, kept between steps. A thread adds the forces of its pairs
 // on its own particles straight into the particle arrays; those on partners in later shares
-// (the list holds a pair under its lower index) it sums here, and the owners add them in. So
-// no core writes into the lines of another share's forces and torques, which that share's
-// thread zeroes, reads and integrates every step.
+// (the list holds a pair under its lower index) it sums here, and the owners add them in. It
+// reads the positions, velocities and spins of those partners from copies that their owners
+// write at the start of the loop (ghosts, as between the ranks of LIGGGHTS). So no thread
+// touches the positions, velocities, spins, forces or torques of another share, which that
+// share's thread zeroes and integrates every step: only these buffers change cores, as
+// contiguous blocks, instead of lines scattered over another share that its kicks then have to
+// take back from the other core.
 struct PairScratch {
   // [thread][particle] for every thread but the last: its sums on partners past its share.
   std::vector<std::vector<Vec3>> force, torque;
-  // Sizes the buffers for n particles and a team of nthreads.
-  void size_for(std::size_t n, int nthreads);
+  // Per thread: the window of partners past its share, [share end, window_end), and the first
+  // particle of its share with a partner in it; found once per neighbour build.
+  std::vector<std::size_t> window_end, cross_from;
+  // [thread][particle - share end]: the ghosts of that window.
+  std::vector<std::vector<Vec3>> ghost_x, ghost_v, ghost_omega;
+  // Per thread: the last loop (epoch) whose ghosts it has written; a cache line each.
+  struct alignas(64) Flag {
+    std::atomic<long> epoch{0};
+  };
+  std::unique_ptr<Flag[]> written;
+  long epoch = 0;
+  const NeighborList* list_of = nullptr;  // the list and build the windows were found for
+  long list_build = -1;
+  int team = 0;
+  std::size_t n = 0;
+  // Sizes the buffers and finds the windows for n particles and a team of nthreads.
+  void size_for(const NeighborList& list, std::size_t n, int nthreads);
 };
 
 struct PairForceArgs {
