@@ -3,6 +3,8 @@
 // build keeps.
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <initializer_list>
 #include <set>
 #include <utility>
 #include <vector>
@@ -15,6 +17,35 @@
 #include "unit_test.h"
 
 using dem::Vec3;
+
+namespace {
+
+// A closed 2 m cube around the origin.
+dem::Domain closed_box() {
+  dem::Domain box;
+  box.boundary = {'f', 'f', 'f'};
+  box.lo = Vec3{-1, -1, -1};
+  box.hi = Vec3{1, 1, 1};
+  return box;
+}
+
+// Spheres of 1 cm radius at the given centres, tags 1, 2, ...
+dem::Particles spheres_at(std::initializer_list<Vec3> centres) {
+  dem::Particles p;
+  for (const Vec3& c : centres)
+    p.add(static_cast<std::int64_t>(p.size()) + 1, 1, 1u, c, 0.01, 2500.0);
+  return p;
+}
+
+// A list with a 2 mm skin, built once.
+dem::NeighborList list_of(const dem::Particles& p, const dem::Domain& box) {
+  dem::NeighborList list;
+  list.skin = 0.002;
+  list.build(p, box);
+  return list;
+}
+
+}  // namespace
 
 TEST_CASE("partition: contiguous shares of about equal weight") {
   // Ten particles; the first five weigh 10 each, the last five 1 each (total 55).
@@ -52,18 +83,11 @@ TEST_CASE("partition: every thread of a team covers its share exactly once") {
 TEST_CASE("neighbour list: a rebuild keeps the history of the pairs touching at the build") {
   // As LIGGGHTS 3.8: what counts is the geometry at the build (the positions of the force
   // evaluation that follows it), not the touching flag of the previous evaluation.
-  dem::Particles p;
-  dem::Domain box;
-  box.boundary = {'f', 'f', 'f'};
-  box.lo = Vec3{-1, -1, -1};
-  box.hi = Vec3{1, 1, 1};
+  const dem::Domain box = closed_box();
   // 1-2 overlap, 2-3 are within the skin but apart.
-  p.add(1, 1, 1u, Vec3{0.0, 0.0, 0.0}, 0.01, 2500.0);
-  p.add(2, 1, 1u, Vec3{0.019, 0.0, 0.0}, 0.01, 2500.0);
-  p.add(3, 1, 1u, Vec3{0.0395, 0.0, 0.0}, 0.01, 2500.0);
-  dem::NeighborList list;
-  list.skin = 0.002;
-  list.build(p, box);
+  dem::Particles p =
+      spheres_at({Vec3{0.0, 0.0, 0.0}, Vec3{0.019, 0.0, 0.0}, Vec3{0.0395, 0.0, 0.0}});
+  dem::NeighborList list = list_of(p, box);
   CHECK_EQ(list.pairs(), std::size_t{2});
   // The flags follow the geometry of the build; a fresh list has no history.
   CHECK_EQ(static_cast<int>(list.touching[0]), 1);
@@ -101,18 +125,11 @@ TEST_CASE("neighbour list: a rebuild keeps the history of the pairs touching at 
 }
 
 TEST_CASE("neighbour list: after a reordering, histories follow the tags and the build geometry") {
-  dem::Particles p;
-  dem::Domain box;
-  box.boundary = {'f', 'f', 'f'};
-  box.lo = Vec3{-1, -1, -1};
-  box.hi = Vec3{1, 1, 1};
+  const dem::Domain box = closed_box();
   // 1-2 overlap, 2-3 are within the skin but apart.
-  p.add(1, 1, 1u, Vec3{0.0, 0.0, 0.0}, 0.01, 2500.0);
-  p.add(2, 1, 1u, Vec3{0.019, 0.0, 0.0}, 0.01, 2500.0);
-  p.add(3, 1, 1u, Vec3{0.0395, 0.0, 0.0}, 0.01, 2500.0);
-  dem::NeighborList list;
-  list.skin = 0.002;
-  list.build(p, box);
+  dem::Particles p =
+      spheres_at({Vec3{0.0, 0.0, 0.0}, Vec3{0.019, 0.0, 0.0}, Vec3{0.0395, 0.0, 0.0}});
+  dem::NeighborList list = list_of(p, box);
   list.history[0] = 1e-6;                  // 1-2, touching
   list.history[dem::kHistorySize] = 2e-6;  // 2-3, apart
   list.touching[1] = 1;                    // 2-3 touched at the last evaluation
@@ -131,10 +148,7 @@ TEST_CASE("neighbour list: a bin with more candidates than the scan buffer finds
   // One big sphere makes the bins 2 x 5 mm wide; 900 small ones fill one, so its stencil holds
   // far more candidates than the search's stack buffer and takes its other path.
   dem::Particles p;
-  dem::Domain box;
-  box.boundary = {'f', 'f', 'f'};
-  box.lo = Vec3{-1, -1, -1};
-  box.hi = Vec3{1, 1, 1};
+  const dem::Domain box = closed_box();
   p.add(1, 1, 1u, Vec3{0.0, 0.0, 0.0}, 0.005, 2500.0);
   for (int k = 0; k < 900; ++k) {
     const double s = static_cast<double>(k);
@@ -160,16 +174,9 @@ TEST_CASE("neighbour list: a bin with more candidates than the scan buffer finds
 }
 
 TEST_CASE("neighbour list: a particle added with a reordering starts without history") {
-  dem::Particles p;
-  dem::Domain box;
-  box.boundary = {'f', 'f', 'f'};
-  box.lo = Vec3{-1, -1, -1};
-  box.hi = Vec3{1, 1, 1};
-  p.add(1, 1, 1u, Vec3{0.0, 0.0, 0.0}, 0.01, 2500.0);
-  p.add(2, 1, 1u, Vec3{0.019, 0.0, 0.0}, 0.01, 2500.0);
-  dem::NeighborList list;
-  list.skin = 0.002;
-  list.build(p, box);
+  const dem::Domain box = closed_box();
+  dem::Particles p = spheres_at({Vec3{0.0, 0.0, 0.0}, Vec3{0.019, 0.0, 0.0}});
+  dem::NeighborList list = list_of(p, box);
   CHECK_EQ(list.pairs(), std::size_t{1});
   list.history[0] = 1e-6;  // 1-2
   // Tag 3 arrives touching particle 1, and the order changes: tags 2, 3, 1.
