@@ -76,6 +76,24 @@ void parse_pair_model(const std::vector<std::string>& w, std::size_t pos, ModelS
 
 namespace {
 
+// How far the pairs of one share reach past it: one past the largest partner (at least the
+// share's end), and the first particle with a partner past the share (the share's end if none).
+struct ShareReach {
+  std::size_t end, from;
+};
+
+ShareReach reach_of(const NeighborList& list, const ParticleShare& own) {
+  ShareReach reach{own.end, own.end};
+  // Partners are sorted, so a particle's last one is its largest.
+  for (std::size_t i = own.begin; i < own.end; ++i) {
+    if (list.first[i + 1] == list.first[i]) continue;
+    const auto last = static_cast<std::size_t>(list.partner[list.first[i + 1] - 1]);
+    if (last >= own.end && reach.from == own.end) reach.from = i;
+    reach.end = std::max(reach.end, last + 1);
+  }
+  return reach;
+}
+
 // A pack whose lane l is f(l).
 template <class P, class F>
 DEM_INLINE P lanes_of(F f) {
@@ -379,14 +397,7 @@ class ComposedModel final : public ContactModel {
       // each reads its partners from the particle arrays and finds its reach here.
       const bool windows = team == scratch.team;
       const auto me = static_cast<std::size_t>(tid);
-      std::size_t end_j = own.end;
-      if (windows) {
-        end_j = scratch.window_end[me];
-      } else {
-        for (std::size_t i = own.begin; i < own.end; ++i)
-          if (first[i + 1] > first[i])
-            end_j = std::max(end_j, static_cast<std::size_t>(partner[first[i + 1] - 1]) + 1);
-      }
+      const std::size_t end_j = windows ? scratch.window_end[me] : reach_of(a.list, own).end;
       touched_end[me] = end_j;
       const std::size_t own_end = own.end;
       // Ghosts of this share's particles in the windows of the earlier threads.
@@ -580,21 +591,15 @@ void PairScratch::size_for(const NeighborList& list, std::size_t n_now, int nthr
   for (int t = 0; t < team; ++t) {
     const auto tt = static_cast<std::size_t>(t);
     const ParticleShare own = list.partition().share(n, t, team);
-    // Partners are sorted, so a particle's last one is its largest.
-    std::size_t end = own.end, from = own.end;
-    for (std::size_t i = own.begin; i < own.end; ++i) {
-      if (list.first[i + 1] == list.first[i]) continue;
-      const auto last = static_cast<std::size_t>(list.partner[list.first[i + 1] - 1]);
-      if (last >= own.end && from == own.end) from = i;
-      end = std::max(end, last + 1);
-    }
-    window_end[tt] = end;
-    cross_from[tt] = from;
+    const ShareReach reach = reach_of(list, own);
+    window_end[tt] = reach.end;
+    cross_from[tt] = reach.from;
     if (t + 1 < team) {
       force[tt].resize(n);
       torque[tt].resize(n);
     }
-    for (auto* ghost : {&ghost_x, &ghost_v, &ghost_omega}) (*ghost)[tt].resize(end - own.end);
+    for (auto* ghost : {&ghost_x, &ghost_v, &ghost_omega})
+      (*ghost)[tt].resize(reach.end - own.end);
   }
 }
 
