@@ -132,15 +132,27 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
     return;
   }
 
+  // The passes over all particles run on all threads: while particles pour in, the list is
+  // rebuilt every few steps, and done on one thread they took a sixth of a build on two.
+  const int nthreads = worker_threads(n);
+  const long ln = static_cast<long>(n);
+  // Bounding box and largest radius (minima and maxima: the same in any order).
   double rmax = 0.0;
-  Vec3 lo = p.x[0], hi = p.x[0];
-  for (std::size_t i = 0; i < n; ++i) {
-    rmax = std::max(rmax, p.radius[i]);
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], p.x[i][k]);
-      hi[k] = std::max(hi[k], p.x[i][k]);
-    }
+  double lo0 = p.x[0][0], lo1 = p.x[0][1], lo2 = p.x[0][2];
+  double hi0 = lo0, hi1 = lo1, hi2 = lo2;
+#pragma omp parallel for schedule(static) num_threads(nthreads) \
+    reduction(max : rmax, hi0, hi1, hi2) reduction(min : lo0, lo1, lo2)
+  for (long i = 0; i < ln; ++i) {
+    const Vec3& x = p.x[static_cast<std::size_t>(i)];
+    rmax = std::max(rmax, p.radius[static_cast<std::size_t>(i)]);
+    lo0 = std::min(lo0, x[0]);
+    lo1 = std::min(lo1, x[1]);
+    lo2 = std::min(lo2, x[2]);
+    hi0 = std::max(hi0, x[0]);
+    hi1 = std::max(hi1, x[1]);
+    hi2 = std::max(hi2, x[2]);
   }
+  Vec3 lo{lo0, lo1, lo2}, hi{hi0, hi1, hi2};
   const double cutoff = 2.0 * rmax + skin;
   std::array<int, 3> nb{};
   std::array<double, 3> origin{}, inv{};
@@ -161,12 +173,13 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   };
   const std::size_t nbins = static_cast<std::size_t>(nb[0]) * nb[1] * nb[2];
   std::vector<int> bin_of(n), bin_start(nbins + 1, 0), bin_items(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const int b = (bin_coord(p.x[i], 2) * nb[1] + bin_coord(p.x[i], 1)) * nb[0] +
-                  bin_coord(p.x[i], 0);
-    bin_of[i] = b;
-    ++bin_start[b + 1];
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+  for (long i = 0; i < ln; ++i) {
+    const Vec3& x = p.x[static_cast<std::size_t>(i)];
+    bin_of[static_cast<std::size_t>(i)] =
+        (bin_coord(x, 2) * nb[1] + bin_coord(x, 1)) * nb[0] + bin_coord(x, 0);
   }
+  for (std::size_t i = 0; i < n; ++i) ++bin_start[static_cast<std::size_t>(bin_of[i]) + 1];
   for (std::size_t b = 0; b < nbins; ++b) bin_start[b + 1] += bin_start[b];
   {
     std::vector<int> fill(bin_start.begin(), bin_start.end() - 1);
@@ -178,16 +191,16 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   // lives in one bin, so the bins can be searched in parallel. The per-particle buffers are kept
   // between builds: their capacity makes later builds allocation-free.
   if (found_.size() < n) found_.resize(n);
-  const int nthreads = worker_threads(n);
   if (!any_periodic) {
     // Positions and radii in bin order: the bins x-1, x, x+1 of a row are consecutive bin
     // indices, so their particles are one contiguous run, and a stencil is 9 runs.
     bin_x_.resize(n);
     bin_r_.resize(n);
-    for (std::size_t s = 0; s < n; ++s) {
-      const auto i = static_cast<std::size_t>(bin_items[s]);
-      bin_x_[s] = p.x[i];
-      bin_r_[s] = p.radius[i];
+#pragma omp parallel for schedule(static) num_threads(nthreads)
+    for (long s = 0; s < ln; ++s) {
+      const auto i = static_cast<std::size_t>(bin_items[static_cast<std::size_t>(s)]);
+      bin_x_[static_cast<std::size_t>(s)] = p.x[i];
+      bin_r_[static_cast<std::size_t>(s)] = p.radius[i];
     }
     const Vec3* bx = bin_x_.data();
     const double* br = bin_r_.data();
@@ -293,7 +306,6 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   // Sized without clearing: every entry is written below, in parallel.
   partner.resize(static_cast<std::size_t>(first[n]));
   history.resize(partner.size() * kHistorySize);
-  const long ln = static_cast<long>(n);
 #pragma omp parallel for schedule(static) num_threads(nthreads)
   for (long i = 0; i < ln; ++i) {
     std::copy(found_[i].begin(), found_[i].end(), partner.begin() + first[i]);
