@@ -39,18 +39,42 @@ bool any_nonzero(const double* hist) {
   return false;
 }
 
+// Bounding box of the positions of p (not empty) and its largest radius. Minima and maxima
+// are the same in any order, so on any number of threads.
+struct Bounds {
+  Vec3 lo, hi;
+  double rmax = 0.0;
+};
+
+Bounds bounds_of(const Particles& p, int nthreads) {
+  const long n = static_cast<long>(p.size());
+  double rmax = 0.0;
+  double lo0 = p.x[0][0], lo1 = p.x[0][1], lo2 = p.x[0][2];
+  double hi0 = lo0, hi1 = lo1, hi2 = lo2;
+#pragma omp parallel for schedule(static) num_threads(nthreads) \
+    reduction(max : rmax, hi0, hi1, hi2) reduction(min : lo0, lo1, lo2)
+  for (long i = 0; i < n; ++i) {
+    const Vec3& x = p.x[static_cast<std::size_t>(i)];
+    rmax = std::max(rmax, p.radius[static_cast<std::size_t>(i)]);
+    lo0 = std::min(lo0, x[0]);
+    lo1 = std::min(lo1, x[1]);
+    lo2 = std::min(lo2, x[2]);
+    hi0 = std::max(hi0, x[0]);
+    hi1 = std::max(hi1, x[1]);
+    hi2 = std::max(hi2, x[2]);
+  }
+  return {{lo0, lo1, lo2}, {hi0, hi1, hi2}, rmax};
+}
+
 }  // namespace
 
 std::vector<std::size_t> spatial_order(const Particles& p, double cell) {
   const std::size_t n = p.size();
   std::vector<std::size_t> order(n);
   if (n == 0) return order;
-  Vec3 lo = p.x[0], hi = p.x[0];
-  for (const Vec3& x : p.x)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], x[k]);
-      hi[k] = std::max(hi[k], x[k]);
-    }
+  const Bounds box = bounds_of(p, worker_threads(n));
+  const Vec3& lo = box.lo;
+  const Vec3& hi = box.hi;
   std::array<long, 3> nb{};
   for (int k = 0; k < 3; ++k) nb[k] = std::clamp(static_cast<long>((hi[k] - lo[k]) / cell) + 1, 1L, 1024L);
   std::vector<long> key(n);
@@ -136,24 +160,9 @@ void NeighborList::build(const Particles& p, const Domain& domain) {
   // rebuilt every few steps, and done on one thread they took a sixth of a build on two.
   const int nthreads = worker_threads(n);
   const long ln = static_cast<long>(n);
-  // Bounding box and largest radius (minima and maxima: the same in any order).
-  double rmax = 0.0;
-  double lo0 = p.x[0][0], lo1 = p.x[0][1], lo2 = p.x[0][2];
-  double hi0 = lo0, hi1 = lo1, hi2 = lo2;
-#pragma omp parallel for schedule(static) num_threads(nthreads) \
-    reduction(max : rmax, hi0, hi1, hi2) reduction(min : lo0, lo1, lo2)
-  for (long i = 0; i < ln; ++i) {
-    const Vec3& x = p.x[static_cast<std::size_t>(i)];
-    rmax = std::max(rmax, p.radius[static_cast<std::size_t>(i)]);
-    lo0 = std::min(lo0, x[0]);
-    lo1 = std::min(lo1, x[1]);
-    lo2 = std::min(lo2, x[2]);
-    hi0 = std::max(hi0, x[0]);
-    hi1 = std::max(hi1, x[1]);
-    hi2 = std::max(hi2, x[2]);
-  }
-  Vec3 lo{lo0, lo1, lo2}, hi{hi0, hi1, hi2};
-  const double cutoff = 2.0 * rmax + skin;
+  const Bounds box = bounds_of(p, nthreads);
+  Vec3 lo = box.lo, hi = box.hi;
+  const double cutoff = 2.0 * box.rmax + skin;
   std::array<int, 3> nb{};
   std::array<double, 3> origin{}, inv{};
   for (int k = 0; k < 3; ++k) {
