@@ -5,7 +5,8 @@ effect is in the profile's catalogue, or which hides nothing or an effect outsid
 of --truths seeds, a blind study is set up (truth drawn, run on --truth-engine with replicates
 and noise) and `snakemake discrepancy` runs on it. The current model is made once under
 OUT/base. Writes OUT/matrix.csv (one row per study) and OUT/matrix.md (scores, confusion
-matrix, rows). Resumable: finished studies are read back, not run again.
+matrix, rows). Resumable: finished studies, and the finished truth runs of an interrupted one,
+are read back, not run again.
 
 Usage: python scripts/discrepancy_matrix.py --profile config/tiny.yaml --out matrix/tiny \\
     [--truths 5] [--first-seed 101] [--spec FILE ...] [--truth-engine "liggghts -in {deck}"]

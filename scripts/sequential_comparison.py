@@ -5,8 +5,8 @@ drawn parameters) the truth is run --replicates times on --truth-engine (default
 3.8 when installed) at the scale of --profile. The mean of the runs with --noise (default 1 %)
 is written as the measurements: the shear-cell readings --observables (default mu_psh and
 rho_b) at the load fractions --P (default 1, every stress) and the angle of repose, as in the
-shipped synthetic reference data. (mu_sh scatters by up to 20 % per run in the quick cell, so a
-5 % acceptance of every reading at every load could not be met even at the truth.) Then, in
+shipped synthetic reference data. (mu_sh at every load adds twelve values that scatter by 1-10 %
+per quick run, so a 5 % acceptance of every one would mostly measure the scatter.) Then, in
 directories of their own under OUT/<material>/:
 
 * ``sequential/``: the study of --profile with --sequential on top (rounds, stopping rule,
@@ -18,9 +18,9 @@ directories of their own under OUT/<material>/:
   from the earlier one's (counted as spent all the same: the copy only saves the driver time).
 
 Writes OUT/comparison.csv, OUT/comparison.md (the table, with the command) and
-OUT/comparison.png (error against DEM runs for both designs). Resumable: finished studies are
-read back, not run again, and an interrupted one continues (the driver unlocks its own study
-directories, so do not run two drivers on the same OUT).
+OUT/comparison.png (error against DEM runs for both designs). Resumable: finished studies and
+truth runs are read back, not run again, and an interrupted study continues (the driver unlocks
+its own study directories, so do not run two drivers on the same OUT).
 
 Usage: python scripts/sequential_comparison.py --out results/sequential_comparison \\
     [--profile config/config.yaml] [--sequential config/sequential.yaml] \\

@@ -4,6 +4,7 @@ The true parameters live in a file that the workflow never reads, so that tests 
 the identification recovers them.
 """
 
+import json
 import tempfile
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -16,7 +17,7 @@ import yaml
 from demcal.bulk.values import extract
 from demcal.core.config import load_config
 from demcal.design.cases import load_condition, shear_suffixes
-from demcal.engine_io.run import run_deck
+from demcal.engine_io.run import engine_command, run_deck
 from demcal.virtual_tests.deck import render_case
 
 
@@ -37,6 +38,22 @@ def simulate_reference(
     return pd.concat(frames, ignore_index=True)
 
 
+def finished_run(case_dir: Path) -> tuple[list[str], str, str] | None:
+    """What a run that finished in ``case_dir`` ran: its command, ``case.json`` and deck text.
+
+    None when there is none: no ``status.json``, a failed run, or files that do not parse.
+    """
+    try:
+        status = json.loads((case_dir / "status.json").read_text())
+        case_text = (case_dir / "case.json").read_text()
+        deck = case_dir / Path(json.loads(case_text)["deck"]).name
+        if status["status"] != "ok":
+            return None
+        return list(status["command"]), case_text, deck.read_text()
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
 def run_case_bulk(
     test: str,
     case: Mapping[str, Any],
@@ -46,18 +63,26 @@ def run_case_bulk(
 ) -> pd.DataFrame:
     """Render, run and read one case: its bulk-value rows with a ``test`` column.
 
+    A run that finished earlier in ``case_dir`` with the same command, ``case.json`` and deck
+    text is read back, not run again, so that an interrupted set of runs resumes where it
+    stopped.
+
     Raises
     ------
     RuntimeError
         When the engine run fails (the message starts with ``label`` and names ``case_dir``).
     """
+    earlier = finished_run(case_dir)
     info = render_case(test, case, config, case_dir)
-    status = run_deck(
-        case_dir,
-        Path(info["deck"]).name,
-        config["engine"]["command"],
-        int(config["engine"]["threads"]),
-    )
+    deck = Path(info["deck"]).name
+    command = engine_command(config["engine"]["command"], deck, int(config["engine"]["threads"]))
+    now = (command, (case_dir / "case.json").read_text(), (case_dir / deck).read_text())
+    if earlier == now:
+        status = json.loads((case_dir / "status.json").read_text())
+    else:
+        status = run_deck(
+            case_dir, deck, config["engine"]["command"], int(config["engine"]["threads"])
+        )
     if status["status"] != "ok":
         raise RuntimeError(f"{label} {case_dir} failed: {status['error']}")
     rows = extract(test, case_dir)
