@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "contact/contact_model.h"
 #include "core/simulation.h"
 #include "deck/errors.h"
 
@@ -66,7 +67,9 @@ int main(int argc, char** argv) {
   }
   try {
     dem::Simulation sim(options);
-    sim.message("dem_engine: " + std::to_string(omp_get_max_threads()) + " OpenMP threads");
+    sim.message("dem_engine: " + std::to_string(omp_get_max_threads()) +
+                " OpenMP threads, contact law on packs of " +
+                std::to_string(dem::contact_pack_lanes()));
     sim.run_deck(deck, vars);
   } catch (const dem::DeckError& e) {
     std::cerr << "ERROR: " << e.what() << '\n';

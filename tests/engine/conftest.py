@@ -59,12 +59,18 @@ class EngineRun:
 
 
 def run_engine(
-    directory: Path, deck: str, threads: int = 1, timeout: float = 300, check: bool = True
+    directory: Path,
+    deck: str,
+    threads: int = 1,
+    timeout: float = 300,
+    check: bool = True,
+    env: dict[str, str] | None = None,
 ) -> EngineRun:
-    """Write ``deck`` to ``directory/in.deck`` and run the engine there."""
+    """Write ``deck`` to ``directory/in.deck`` and run the engine there (``env``: more
+    environment variables)."""
     directory.mkdir(parents=True, exist_ok=True)
     (directory / "in.deck").write_text(deck)
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads), **(env or {}))
     res = subprocess.run(
         [engine_path(), "-in", "in.deck", "-log", "log.liggghts", "-noprogress"],
         cwd=directory,

@@ -1,5 +1,7 @@
 """Thread count and repeatability: 2 000 spheres settling in a walled box."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -10,7 +12,7 @@ from .conftest import header, material_block, run_engine
 pytestmark = pytest.mark.engine
 
 
-def settling_deck(steps: int, seed: int = 5) -> str:
+def settling_deck(steps: int, seed: int = 5, cohesion: float | None = None) -> str:
     rng = np.random.default_rng(seed)
     spacing, nx, nz = 0.0022, 10, 20  # 10 x 10 x 20 = 2 000 spheres of radius 1 mm
     half = nx * spacing / 2
@@ -24,7 +26,8 @@ def settling_deck(steps: int, seed: int = 5) -> str:
                 atoms.append(
                     "create_atoms 1 single {!r} {!r} {!r} units box".format(*map(float, p))
                 )
-    model = "model hertz tangential history rolling_friction epsd2"
+    sjkr = " cohesion sjkr" if cohesion is not None else ""
+    model = f"model hertz tangential history{sjkr} rolling_friction epsd2"
     walls = "\n".join(
         f"fix w{n} all wall/gran {model} primitive type 2 {plane} {pos!r}"
         for n, (plane, pos) in enumerate(
@@ -42,7 +45,7 @@ def settling_deck(steps: int, seed: int = 5) -> str:
             "region box block -0.05 0.05 -0.05 0.05 -0.05 0.05",
             "region box block -0.05 0.05 -0.05 0.05 -0.01 0.09",
         )
-        + material_block(5e6, 0.4, 0.6, 0.5, rolling=0.3, ntypes=2)
+        + material_block(5e6, 0.4, 0.6, 0.5, rolling=0.3, cohesion=cohesion, ntypes=2)
         + f"pair_style gran {model}\npair_coeff * *\ntimestep 1e-5\n"
         + "\n".join(atoms)
         + "\nset group all diameter 0.002 density 2500\n"
@@ -51,6 +54,34 @@ def settling_deck(steps: int, seed: int = 5) -> str:
         + f"dump d all custom {steps} final.dump id x y z vx vy vz\n"
         + f"thermo_style custom step atoms ke\nthermo 500\nrun {steps}\n"
     )
+
+
+def _cpu_has_avx512() -> bool:
+    cpuinfo = Path("/proc/cpuinfo")
+    return cpuinfo.is_file() and " avx512f" in cpuinfo.read_text()
+
+
+@pytest.mark.skipif(
+    not _cpu_has_avx512(), reason="no AVX-512 on this CPU: the engine has only packs of 4"
+)
+@pytest.mark.parametrize(("threads", "cohesion"), [(1, None), (2, 2e4)])
+def test_packs_of_eight_and_of_four_give_the_same_bits(tmp_path, threads, cohesion):
+    # With AVX-512 the pair law runs on eight contacts at once, otherwise on four; both round
+    # every operation lane by lane as one contact at a time, so every bit of the state agrees.
+    fields = "x y z vx vy vz omegax omegay omegaz fx fy fz tqx tqy tqz"
+    exact = " ".join(["%d"] + ["%.17g"] * len(fields.split()))
+    deck = settling_deck(1500, cohesion=cohesion).replace(
+        "final.dump id x y z vx vy vz\n",
+        f'final.dump id {fields}\ndump_modify d sort id format "{exact}"\n',
+    )
+    assert "dump_modify d sort id" in deck
+    wide = run_engine(tmp_path / "8", deck, threads=threads)
+    narrow = run_engine(tmp_path / "4", deck, threads=threads, env={"DEM_ENGINE_NO_AVX512": "1"})
+    assert "packs of 8" in wide.stdout
+    assert "packs of 4" in narrow.stdout
+    dump = (wide.directory / "final.dump").read_text()
+    assert len(dump.splitlines()) == 2 * (9 + 2000)  # steps 0 and 1 500
+    assert dump == (narrow.directory / "final.dump").read_text()
 
 
 def _final(run):

@@ -98,7 +98,13 @@ ShareReach reach_of(const NeighborList& list, const ParticleShare& own) {
 template <class P, class F>
 DEM_INLINE P lanes_of(F f) {
   if constexpr (std::is_same_v<P, Pack2>) return P(f(0), f(1));
-  else return P(f(0), f(1), f(2), f(3));
+  else if constexpr (std::is_same_v<P, Pack4>) return P(f(0), f(1), f(2), f(3));
+  else {
+    // Two halves joined: built lane by lane, GCC fills an 8-lane vector with one masked
+    // broadcast per lane.
+    const Pack4 lo(f(0), f(1), f(2), f(3)), hi(f(4), f(5), f(6), f(7));
+    return P(__builtin_shufflevector(lo.v, hi.v, 0, 1, 2, 3, 4, 5, 6, 7));
+  }
 }
 
 // The material parameters of the pack's contacts, lane l from q[l].
@@ -147,17 +153,18 @@ class ComposedModel final : public ContactModel {
   }
 
  private:
-  // Pairs run four at a time (one AVX instruction per operation where the CPU has AVX): the
-  // contact law is a chain of square roots and divisions, and four independent contacts
-  // keep more of them in flight than two. Walls, a few per cent of the time, run in pairs.
-  using Pack = Pack4;
-  static constexpr int kLanes = 4;
+  // Pairs run four at a time (one AVX instruction per operation where the CPU has AVX), or
+  // eight where it has AVX-512: the contact law is a chain of square roots and divisions,
+  // and more independent contacts keep more of them in flight; on CPUs whose AVX-512 units
+  // are 512 bits wide, eight lanes also halve the square roots and divisions issued. Walls,
+  // a few per cent of the time, run in pairs.
   using WallPack = Pack2;
   static constexpr int kWallLanes = 2;
+  static constexpr int kMaxLanes = 8;
   static constexpr int kBatch = 128;  // contacts per batch: its buffers stay in L1
   // Entries per batch buffer: the spare ones past kBatch take the dropped lanes of the last
   // pack. A fixed stride lets one register address every result column.
-  static constexpr int kStride = kBatch + kLanes;
+  static constexpr int kStride = kBatch + kMaxLanes;
 
   // Where a thread reads its partners j >= from: x[j - from] etc. (see PairScratch).
   struct Ghosts {
@@ -165,26 +172,52 @@ class ComposedModel final : public ContactModel {
     const Vec3 *x, *v, *omega;
   };
 
+  // The material parameters of the last pack of type P, reused while the type pairs repeat
+  // (always, with one particle type).
+  template <class P, int Lanes>
+  struct ParamsCache {
+    const PairParams* of[Lanes] = {};
+    PairParamsT<P> params;
+  };
+
   // Touching pairs waiting for their contact law: particle i, its partner j, the list entry k,
   // and the results (force on i, torque on i, torque on j, overlap), one array per component
   // so that a pack of results is stored at once. Kept per thread between steps.
   struct Batch {
     int i[kStride], j[kStride], k[kStride];
-    alignas(32) double out[10][kStride];
+    alignas(64) double out[10][kStride];
     int size = 0;
     bool ghosted = false;  // whether an entry's partner is read from the ghosts
-    // The material parameters of the last pack, reused while the type pairs repeat (always,
-    // with one particle type).
-    const PairParams* params_of[kLanes] = {};
-    PairParamsT<Pack> params;
+    ParamsCache<Pack4, 4> params4;
+    ParamsCache<Pack8, 8> params8;
+    template <class P>
+    auto& params_cache() {
+      if constexpr (std::is_same_v<P, Pack4>) return params4;
+      else return params8;
+    }
   };
+
+  // The contact laws of batch entries 0 .. b.size - 1, four at a time (AVX or plain x86-64)
+  // or eight (AVX-512, where avx512_cpu()).
+  template <bool Periodic, bool Ghosted>
+  DEM_AVX_CLONES void contact_packs4(const PairForceArgs& a, const ContactStep& step, Batch& b,
+                                     const Ghosts& g) const {
+    for (int h = 0; h < b.size; h += 4)
+      contact_pack<Periodic, Ghosted, Pack4, 4>(a, step, b, g, h, std::min(4, b.size - h));
+  }
+  template <bool Periodic, bool Ghosted>
+  DEM_AVX512 void contact_packs8(const PairForceArgs& a, const ContactStep& step, Batch& b,
+                                 const Ghosts& g) const {
+    for (int h = 0; h < b.size; h += 8)
+      contact_pack<Periodic, Ghosted, Pack8, 8>(a, step, b, g, h, std::min(8, b.size - h));
+  }
 
   // The contact law of batch entries e0 .. e0 + count - 1 (count <= kLanes) in one pack; the
   // lanes past count repeat the last contact and are dropped. Packs are filled straight from
   // the particle arrays, and with Ghosted from the ghosts g for partners past the thread's share.
-  template <bool Periodic, bool Ghosted>
-  DEM_AVX_CLONES void contact_pack(const PairForceArgs& a, const ContactStep& step, Batch& b,
-                                   const Ghosts& g, int e0, int count) const {
+  template <bool Periodic, bool Ghosted, class Pack, int kLanes>
+  DEM_INLINE void contact_pack(const PairForceArgs& a, const ContactStep& step, Batch& b,
+                               const Ghosts& g, int e0, int count) const {
     const Particles& P = a.atoms;
     const Vec3* x = P.x.data();
     const Vec3* v = P.v.data();
@@ -200,10 +233,12 @@ class ComposedModel final : public ContactModel {
       jj[l] = static_cast<std::size_t>(b.j[e]);
       kk[l] = b.k[e];
     }
-    auto pack1 = [&](const double* of, const std::size_t* idx) {
+    // The lambdas returning packs are always inlined: an out-of-line copy would be compiled
+    // for plain x86-64 and pass the packs through memory.
+    auto pack1 = [&](const double* of, const std::size_t* idx) DEM_INLINE_LAMBDA {
       return lanes_of<Pack>([&](int l) { return of[idx[l]]; });
     };
-    auto pack3 = [&](const Vec3* of, const std::size_t* idx) {
+    auto pack3 = [&](const Vec3* of, const std::size_t* idx) DEM_INLINE_LAMBDA {
       return V{lanes_of<Pack>([&](int l) { return of[idx[l]].x; }),
                lanes_of<Pack>([&](int l) { return of[idx[l]].y; }),
                lanes_of<Pack>([&](int l) { return of[idx[l]].z; })};
@@ -219,7 +254,7 @@ class ComposedModel final : public ContactModel {
         pv[l] = (ghost ? g.v : v) + at;
         pw[l] = (ghost ? g.omega : w) + at;
       }
-      auto pack3_at = [&](const Vec3* const* of) {
+      auto pack3_at = [&](const Vec3* const* of) DEM_INLINE_LAMBDA {
         return V{lanes_of<Pack>([&](int l) { return of[l]->x; }),
                  lanes_of<Pack>([&](int l) { return of[l]->y; }),
                  lanes_of<Pack>([&](int l) { return of[l]->z; })};
@@ -238,7 +273,8 @@ class ComposedModel final : public ContactModel {
       Vec3 dl[kLanes];
       for (int l = 0; l < kLanes; ++l)
         dl[l] = a.domain.minimum_image(x[ii[l]] - Vec3{xj.x[l], xj.y[l], xj.z[l]});
-      const std::size_t lane[kLanes] = {0, 1, 2, 3};
+      std::size_t lane[kLanes];
+      for (int l = 0; l < kLanes; ++l) lane[l] = static_cast<std::size_t>(l);
       d = pack3(dl, lane);
     } else {
       d = pack3(x, ii) - xj;
@@ -269,17 +305,18 @@ class ComposedModel final : public ContactModel {
     c.v_rel = pack3(v, ii) - vj;
     c.omega_i = pack3(w, ii);
     c.omega_j = wj;
+    auto& cache = b.template params_cache<Pack>();
     const PairParams* q[kLanes];
     bool same = true;
     for (int l = 0; l < kLanes; ++l) {
       q[l] = &a.material.get(P.type[ii[l]], P.type[jj[l]]);
-      same = same && q[l] == b.params_of[l];
+      same = same && q[l] == cache.of[l];
     }
     if (!same) {
-      b.params = pack_params<Pack>(q);
-      for (int l = 0; l < kLanes; ++l) b.params_of[l] = q[l];
+      cache.params = pack_params<Pack>(q);
+      for (int l = 0; l < kLanes; ++l) cache.of[l] = q[l];
     }
-    const PairParamsT<Pack>& p = b.params;
+    const PairParamsT<Pack>& p = cache.params;
     double* h[kLanes];
     for (int l = 0; l < kLanes; ++l)
       h[l] = a.list.history.data() + static_cast<std::size_t>(kk[l]) * kHistorySize;
@@ -355,6 +392,7 @@ class ComposedModel final : public ContactModel {
 
   // m_i m_j / (m_i + m_j); with fix freeze, a zero mass stands for a frozen particle and the
   // effective mass is the other one's.
+  template <class Pack>
   DEM_INLINE static Pack m_effective(const Pack& mi, const Pack& mj, bool freeze) {
     const Pack m_eff = mi * mj / (mi + mj);
     if (!freeze) return m_eff;
@@ -373,6 +411,7 @@ class ComposedModel final : public ContactModel {
     step.options = spec().options;
     step.dt = a.dt;
     step.update_history = a.update_history;
+    const bool wide = avx512_cpu();
     double worst_ratio = 0.0;
     long worst_tag = -1;
     long contacts = 0;
@@ -446,7 +485,8 @@ class ComposedModel final : public ContactModel {
       batch.size = 0;
       batch.ghosted = false;
       // The material table may have changed.
-      std::fill(std::begin(batch.params_of), std::end(batch.params_of), nullptr);
+      batch.params4 = {};
+      batch.params8 = {};
       double my_ratio = 0.0;
       long my_tag = -1;
       int* const bi = batch.i;
@@ -456,12 +496,10 @@ class ComposedModel final : public ContactModel {
       const std::int64_t* const tag = P.tag.data();
       auto flush = [&]() {
         const int size = batch.size;
-        for (int h = 0; h < size; h += kLanes) {
-          if (batch.ghosted)
-            contact_pack<Periodic, true>(a, step, batch, ghosts, h, std::min(kLanes, size - h));
-          else
-            contact_pack<Periodic, false>(a, step, batch, ghosts, h, std::min(kLanes, size - h));
-        }
+        if (wide && batch.ghosted) contact_packs8<Periodic, true>(a, step, batch, ghosts);
+        else if (wide) contact_packs8<Periodic, false>(a, step, batch, ghosts);
+        else if (batch.ghosted) contact_packs4<Periodic, true>(a, step, batch, ghosts);
+        else contact_packs4<Periodic, false>(a, step, batch, ghosts);
         // The sums on i stay in registers while its contacts follow one another (partners
         // have j > i, so no other contact of the batch adds to f[i] meanwhile).
         for (int h = 0; h < size;) {
@@ -602,6 +640,8 @@ void PairScratch::size_for(const NeighborList& list, std::size_t n_now, int nthr
       (*ghost)[tt].resize(reach.end - own.end);
   }
 }
+
+int contact_pack_lanes() { return avx512_cpu() ? 8 : 4; }
 
 std::unique_ptr<ContactModel> make_contact_model(const ModelSpec& spec) {
   if (spec.cohesion_sjkr && spec.rolling_epsd2)

@@ -118,4 +118,7 @@ class ContactModel {
 
 std::unique_ptr<ContactModel> make_contact_model(const ModelSpec& spec);
 
+// Contacts per pack of the pair law on this CPU: 8 with AVX-512, else 4 (same results).
+int contact_pack_lanes();
+
 }  // namespace dem

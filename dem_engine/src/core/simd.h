@@ -1,6 +1,7 @@
 #pragma once
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <type_traits>
 
@@ -14,8 +15,10 @@
 // on packs are worth running only as one instruction stream with the code that fills the packs.
 #if defined(__GNUC__)
 #define DEM_INLINE [[gnu::always_inline]] inline
+#define DEM_INLINE_LAMBDA __attribute__((always_inline))
 #else
 #define DEM_INLINE inline
+#define DEM_INLINE_LAMBDA
 #endif
 
 // A function compiled twice, for AVX and for plain x86-64, the copy chosen once at start-up by
@@ -26,6 +29,24 @@
 #define DEM_AVX_CLONES __attribute__((target_clones("avx", "default")))
 #else
 #define DEM_AVX_CLONES
+#endif
+
+// A function compiled for AVX-512 only, called where avx512_cpu() says the CPU has it: eight
+// doubles per instruction. The build compiles without floating-point contraction
+// (-ffp-contract=off), so the fused multiply-adds AVX-512 brings are never formed and such a
+// function rounds exactly as the other copies.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define DEM_AVX512 __attribute__((target("avx512f")))
+// DEM_ENGINE_NO_AVX512 set (to anything) keeps the four-lane copies on such a CPU too, so the
+// two can be compared on one machine.
+inline bool avx512_cpu() {
+  static const bool use =
+      __builtin_cpu_supports("avx512f") && std::getenv("DEM_ENGINE_NO_AVX512") == nullptr;
+  return use;
+}
+#else
+#define DEM_AVX512
+inline bool avx512_cpu() { return false; }
 #endif
 
 namespace dem {
@@ -162,45 +183,128 @@ inline Pack4 select(const Mask4& mask, const Pack4& a, const Pack4& b) {
 }
 inline bool any(const Mask4& mask) { return (mask.m[0] | mask.m[1] | mask.m[2] | mask.m[3]) != 0; }
 
+// Eight doubles in lockstep, as Pack4: one 512-bit instruction per operation in an AVX-512
+// function (DEM_AVX512), split into narrower ones elsewhere. Its operations are always
+// inlined: a call from an AVX-512 function to an out-of-line copy compiled for plain x86-64
+// would pass every pack through memory.
+struct Pack8 {
+  typedef double Raw __attribute__((vector_size(64)));
+  typedef std::int64_t Bits __attribute__((vector_size(64)));
+  Raw v;
+
+  DEM_INLINE Pack8() : v{0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0} {}
+  DEM_INLINE Pack8(double s) : v{s, s, s, s, s, s, s, s} {}  // NOLINT: implicit broadcast
+  DEM_INLINE Pack8(double a, double b, double c, double d, double e, double f, double g, double h)
+      : v{a, b, c, d, e, f, g, h} {}
+  DEM_INLINE explicit Pack8(Raw r) : v(r) {}
+  DEM_INLINE double operator[](int lane) const { return v[lane]; }
+  DEM_INLINE void store(double* to) const { std::memcpy(to, &v, sizeof v); }
+  DEM_INLINE Pack8& operator+=(const Pack8& o) { v += o.v; return *this; }
+  DEM_INLINE Pack8& operator-=(const Pack8& o) { v -= o.v; return *this; }
+  DEM_INLINE Pack8& operator*=(const Pack8& o) { v *= o.v; return *this; }
+};
+
+DEM_INLINE Pack8 operator+(const Pack8& a, const Pack8& b) { return Pack8(a.v + b.v); }
+DEM_INLINE Pack8 operator-(const Pack8& a, const Pack8& b) { return Pack8(a.v - b.v); }
+DEM_INLINE Pack8 operator*(const Pack8& a, const Pack8& b) { return Pack8(a.v * b.v); }
+DEM_INLINE Pack8 operator/(const Pack8& a, const Pack8& b) { return Pack8(a.v / b.v); }
+DEM_INLINE Pack8 operator-(const Pack8& a) { return Pack8(-a.v); }
+DEM_INLINE Pack8 lane_sqrt(const Pack8& a) {
+  Pack8 r;
+  for (int l = 0; l < 8; ++l) r.v[l] = std::sqrt(a.v[l]);
+  return r;
+}
+// |a|: clears the sign bits, exactly as std::fabs.
+DEM_INLINE Pack8 lane_abs(const Pack8& a) {
+  const Pack8::Bits sign = Pack8::Bits{} + INT64_MIN;
+  return Pack8(reinterpret_cast<Pack8::Raw>(reinterpret_cast<Pack8::Bits>(a.v) & ~sign));
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+// Lane mask of a Pack8 comparison, one bit per lane. Written on generic vectors, GCC compares
+// lane by lane inside the contact law; these use the AVX-512 comparison and blend instead.
+// The builtins are declared by switching the target on and off once; they expand only inside
+// the AVX-512 functions that use Pack8 (anywhere else the build fails).
+#pragma GCC push_options
+#pragma GCC target("avx512f")
+#pragma GCC pop_options
+struct Mask8 {
+  unsigned char bits;
+};
+// Predicates 0x0e (greater) and 0x01 (less), ordered and signalling, are those of the C
+// comparisons: false where a lane is NaN.
+DEM_INLINE Mask8 operator>(const Pack8& a, const Pack8& b) {
+  return {__builtin_ia32_cmppd512_mask(a.v, b.v, 0x0e, 0xff, 4)};
+}
+DEM_INLINE Mask8 operator<(const Pack8& a, const Pack8& b) {
+  return {__builtin_ia32_cmppd512_mask(a.v, b.v, 0x01, 0xff, 4)};
+}
+DEM_INLINE Mask8 operator&&(const Mask8& a, const Mask8& b) {
+  return {static_cast<unsigned char>(a.bits & b.bits)};
+}
+// a where the mask is set, b elsewhere (exact copies).
+DEM_INLINE Pack8 select(const Mask8& mask, const Pack8& a, const Pack8& b) {
+  return Pack8(__builtin_ia32_blendmpd_512_mask(b.v, a.v, mask.bits));
+}
+DEM_INLINE bool any(const Mask8& mask) { return mask.bits != 0; }
+#else
+// Elsewhere Pack8 is not used (avx512_cpu() is false); generic masks as for Pack4.
+struct Mask8 {
+  Pack8::Bits m;
+};
+DEM_INLINE Mask8 operator>(const Pack8& a, const Pack8& b) { return {a.v > b.v}; }
+DEM_INLINE Mask8 operator<(const Pack8& a, const Pack8& b) { return {a.v < b.v}; }
+DEM_INLINE Mask8 operator&&(const Mask8& a, const Mask8& b) { return {a.m & b.m}; }
+DEM_INLINE Pack8 select(const Mask8& mask, const Pack8& a, const Pack8& b) {
+  return Pack8(mask.m ? a.v : b.v);
+}
+DEM_INLINE bool any(const Mask8& mask) {
+  std::int64_t bits = 0;
+  for (int l = 0; l < 8; ++l) bits |= mask.m[l];
+  return bits != 0;
+}
+#endif
+
 // The same operations on plain doubles, so that contact code can be written once for both.
 inline double lane_sqrt(double a) { return std::sqrt(a); }
 inline double lane_abs(double a) { return std::fabs(a); }
 inline double select(bool mask, double a, double b) { return mask ? a : b; }
 inline bool any(bool mask) { return mask; }
 
-// A vector of packs: lane l of each component is the vector of one contact.
+// A vector of packs: lane l of each component is the vector of one contact. Always inlined,
+// as the pack operations (see Pack8).
 template <class R>
 struct Vec3T {
   R x, y, z;
   Vec3T() = default;
-  Vec3T(const R& a, const R& b, const R& c) : x(a), y(b), z(c) {}
-  Vec3T& operator+=(const Vec3T& o) { x += o.x; y += o.y; z += o.z; return *this; }
-  Vec3T& operator-=(const Vec3T& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-  Vec3T& operator*=(const R& s) { x *= s; y *= s; z *= s; return *this; }
+  DEM_INLINE Vec3T(const R& a, const R& b, const R& c) : x(a), y(b), z(c) {}
+  DEM_INLINE Vec3T& operator+=(const Vec3T& o) { x += o.x; y += o.y; z += o.z; return *this; }
+  DEM_INLINE Vec3T& operator-=(const Vec3T& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
+  DEM_INLINE Vec3T& operator*=(const R& s) { x *= s; y *= s; z *= s; return *this; }
 };
 
-template <class R> Vec3T<R> operator+(Vec3T<R> a, const Vec3T<R>& b) { return a += b; }
-template <class R> Vec3T<R> operator-(Vec3T<R> a, const Vec3T<R>& b) { return a -= b; }
-template <class R> Vec3T<R> operator-(const Vec3T<R>& a) { return {-a.x, -a.y, -a.z}; }
+template <class R> DEM_INLINE Vec3T<R> operator+(Vec3T<R> a, const Vec3T<R>& b) { return a += b; }
+template <class R> DEM_INLINE Vec3T<R> operator-(Vec3T<R> a, const Vec3T<R>& b) { return a -= b; }
+template <class R> DEM_INLINE Vec3T<R> operator-(const Vec3T<R>& a) { return {-a.x, -a.y, -a.z}; }
 // R is taken from the vector only, so that a double scalar broadcasts.
 template <class T> struct NoDeduce { using type = T; };
 // Vec3 multiplies each component by the scalar on the right (a.x * s); so do these.
-template <class R> Vec3T<R> operator*(Vec3T<R> a, const typename NoDeduce<R>::type& s) {
+template <class R> DEM_INLINE Vec3T<R> operator*(Vec3T<R> a, const typename NoDeduce<R>::type& s) {
   return a *= s;
 }
-template <class R> Vec3T<R> operator*(const typename NoDeduce<R>::type& s, Vec3T<R> a) {
+template <class R> DEM_INLINE Vec3T<R> operator*(const typename NoDeduce<R>::type& s, Vec3T<R> a) {
   return a *= s;
 }
-template <class R> R dot(const Vec3T<R>& a, const Vec3T<R>& b) {
+template <class R> DEM_INLINE R dot(const Vec3T<R>& a, const Vec3T<R>& b) {
   return a.x * b.x + a.y * b.y + a.z * b.z;
 }
-template <class R> Vec3T<R> cross(const Vec3T<R>& a, const Vec3T<R>& b) {
+template <class R> DEM_INLINE Vec3T<R> cross(const Vec3T<R>& a, const Vec3T<R>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-template <class R> R norm2(const Vec3T<R>& a) { return dot(a, a); }
-template <class R> R norm(const Vec3T<R>& a) { return lane_sqrt(dot(a, a)); }
+template <class R> DEM_INLINE R norm2(const Vec3T<R>& a) { return dot(a, a); }
+template <class R> DEM_INLINE R norm(const Vec3T<R>& a) { return lane_sqrt(dot(a, a)); }
 template <class R, class M>
-Vec3T<R> select(const M& mask, const Vec3T<R>& a, const Vec3T<R>& b) {
+DEM_INLINE Vec3T<R> select(const M& mask, const Vec3T<R>& a, const Vec3T<R>& b) {
   return {select(mask, a.x, b.x), select(mask, a.y, b.y), select(mask, a.z, b.z)};
 }
 inline Vec3 select(bool mask, const Vec3& a, const Vec3& b) { return mask ? a : b; }
