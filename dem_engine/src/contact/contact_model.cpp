@@ -142,8 +142,8 @@ class ComposedModel final : public ContactModel {
   void wall_forces(const Particles& P, const MaterialTable& material, const ContactStep& step,
                    const WallContact* contacts, std::size_t count,
                    ContactResult* results) const override {
-    for (std::size_t h = 0; h < count; h += kWallLanes)
-      wall_pack(P, material, step, contacts, h, h + 1 < count, results);
+    if (avx512_cpu()) wall_packs8(P, material, step, contacts, count, results);
+    else wall_packs4(P, material, step, contacts, count, results);
   }
 
   void pair_forces(PairForceArgs& a) const override {
@@ -156,10 +156,8 @@ class ComposedModel final : public ContactModel {
   // Pairs run four at a time (one AVX instruction per operation where the CPU has AVX), or
   // eight where it has AVX-512: the contact law is a chain of square roots and divisions,
   // and more independent contacts keep more of them in flight; on CPUs whose AVX-512 units
-  // are 512 bits wide, eight lanes also halve the square roots and divisions issued. Walls,
-  // a few per cent of the time, run in pairs.
-  using WallPack = Pack2;
-  static constexpr int kWallLanes = 2;
+  // are 512 bits wide, eight lanes also halve the square roots and divisions issued. Wall
+  // contacts run the same way.
   static constexpr int kMaxLanes = 8;
   static constexpr int kBatch = 128;  // contacts per batch: its buffers stay in L1
   // Entries per batch buffer: the spare ones past kBatch take the dropped lanes of the last
@@ -341,52 +339,77 @@ class ComposedModel final : public ContactModel {
     c.overlap.store(&b.out[9][e0]);
   }
 
-  // Wall contacts e0 and e1 in one pack, set up as WallContact says (e1 = e0 for
-  // a lone last contact, whose second lane is dropped).
-  DEM_AVX_CLONES void wall_pack(const Particles& P, const MaterialTable& material,
-                                const ContactStep& step, const WallContact* contacts,
-                                std::size_t e0, bool two, ContactResult* results) const {
-    using V = Vec3T<WallPack>;
-    const WallContact& w0 = contacts[e0];
-    const WallContact& w1 = contacts[two ? e0 + 1 : e0];
-    const std::size_t i0 = w0.i, i1 = w1.i;
-    auto pack3 = [](const Vec3& p0, const Vec3& p1) {
-      return V{WallPack(p0.x, p1.x), WallPack(p0.y, p1.y), WallPack(p0.z, p1.z)};
+  // The laws of wall contacts 0 .. count - 1, four at a time (AVX or plain x86-64) or eight
+  // (AVX-512).
+  DEM_AVX_CLONES void wall_packs4(const Particles& P, const MaterialTable& material,
+                                  const ContactStep& step, const WallContact* contacts,
+                                  std::size_t count, ContactResult* results) const {
+    for (std::size_t h = 0; h < count; h += 4)
+      wall_pack<Pack4, 4>(P, material, step, contacts, h, std::min<std::size_t>(4, count - h),
+                          results);
+  }
+  DEM_AVX512 void wall_packs8(const Particles& P, const MaterialTable& material,
+                              const ContactStep& step, const WallContact* contacts,
+                              std::size_t count, ContactResult* results) const {
+    for (std::size_t h = 0; h < count; h += 8)
+      wall_pack<Pack8, 8>(P, material, step, contacts, h, std::min<std::size_t>(8, count - h),
+                          results);
+  }
+
+  // Wall contacts e0 .. e0 + count - 1 (count <= kLanes) in one pack, set up as WallContact
+  // says; the lanes past count repeat the last contact and are dropped.
+  template <class Pack, int kLanes>
+  DEM_INLINE void wall_pack(const Particles& P, const MaterialTable& material,
+                            const ContactStep& step, const WallContact* contacts, std::size_t e0,
+                            std::size_t count, ContactResult* results) const {
+    using V = Vec3T<Pack>;
+    const WallContact* w[kLanes];
+    std::size_t i[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      w[l] = &contacts[e0 + std::min(static_cast<std::size_t>(l), count - 1)];
+      i[l] = w[l]->i;
+    }
+    auto pack1 = [&](auto of) DEM_INLINE_LAMBDA { return lanes_of<Pack>(of); };
+    auto pack3 = [&](auto of) DEM_INLINE_LAMBDA {
+      return V{lanes_of<Pack>([&](int l) { return of(l).x; }),
+               lanes_of<Pack>([&](int l) { return of(l).y; }),
+               lanes_of<Pack>([&](int l) { return of(l).z; })};
     };
-    ContactInputT<WallPack> c;
+    ContactInputT<Pack> c;
     c.wall = true;
-    c.n = pack3(w0.normal, w1.normal);
-    c.overlap = WallPack(w0.overlap, w1.overlap);
-    c.dist = WallPack(w0.dist, w1.dist);
-    c.ri = WallPack(P.radius[i0], P.radius[i1]);
+    c.n = pack3([&](int l) -> const Vec3& { return w[l]->normal; });
+    c.overlap = pack1([&](int l) { return w[l]->overlap; });
+    c.dist = pack1([&](int l) { return w[l]->dist; });
+    c.ri = pack1([&](int l) { return P.radius[i[l]]; });
     c.rj = 0.0;
     c.r_eff = c.ri;
-    c.m_eff = WallPack(P.rmass[i0], P.rmass[i1]);
+    c.m_eff = pack1([&](int l) { return P.rmass[i[l]]; });
     c.cri = c.ri - 0.5 * c.overlap;
     c.crj = 0.0;
-    c.v_rel = pack3(P.v[i0], P.v[i1]) - pack3(w0.wall_velocity, w1.wall_velocity);
-    c.omega_i = pack3(P.omega[i0], P.omega[i1]);
-    c.omega_j = V{WallPack(0.0), WallPack(0.0), WallPack(0.0)};
-    const PairParams* pair[kWallLanes] = {&material.get(P.type[i0], w0.wall_type),
-                                          &material.get(P.type[i1], w1.wall_type)};
-    const PairParamsT<WallPack> p = pack_params<WallPack>(pair);
-    WallPack hist[kHistorySize];
-    for (int q = 0; q < kHistorySize; ++q) hist[q] = WallPack(w0.history[q], w1.history[q]);
-    ContactResultT<WallPack> res;
+    c.v_rel = pack3([&](int l) -> const Vec3& { return P.v[i[l]]; }) -
+              pack3([&](int l) -> const Vec3& { return w[l]->wall_velocity; });
+    c.omega_i = pack3([&](int l) -> const Vec3& { return P.omega[i[l]]; });
+    c.omega_j = V{Pack(0.0), Pack(0.0), Pack(0.0)};
+    const PairParams* pair[kLanes];
+    for (int l = 0; l < kLanes; ++l) pair[l] = &material.get(P.type[i[l]], w[l]->wall_type);
+    const PairParamsT<Pack> p = pack_params<Pack>(pair);
+    Pack hist[kHistorySize];
+    for (int q = 0; q < kHistorySize; ++q) hist[q] = pack1([&](int l) { return w[l]->history[q]; });
+    ContactResultT<Pack> res;
     contact_law<Cohesion, Rolling>(c, p, step, hist, res);
-    const int lanes = two ? 2 : 1;
-    for (int l = 0; l < lanes; ++l) {
-      double* h = l == 0 ? w0.history : w1.history;
-      for (int q = 0; q < kHistorySize; ++q) h[q] = hist[q][l];
-      ContactResult& r = results[e0 + static_cast<std::size_t>(l)];
-      r.fn = res.fn[l];
-      r.fn_limit = res.fn_limit[l];
-      r.kn = res.kn[l];
-      r.kt = res.kt[l];
-      r.gamma_t = res.gamma_t[l];
-      r.force = Vec3{res.force.x[l], res.force.y[l], res.force.z[l]};
-      r.torque_i = Vec3{res.torque_i.x[l], res.torque_i.y[l], res.torque_i.z[l]};
-      r.torque_j = Vec3{res.torque_j.x[l], res.torque_j.y[l], res.torque_j.z[l]};
+    for (std::size_t l = 0; l < count; ++l) {
+      const auto lane = static_cast<int>(l);
+      double* h = w[lane]->history;
+      for (int q = 0; q < kHistorySize; ++q) h[q] = hist[q][lane];
+      ContactResult& r = results[e0 + l];
+      r.fn = res.fn[lane];
+      r.fn_limit = res.fn_limit[lane];
+      r.kn = res.kn[lane];
+      r.kt = res.kt[lane];
+      r.gamma_t = res.gamma_t[lane];
+      r.force = Vec3{res.force.x[lane], res.force.y[lane], res.force.z[lane]};
+      r.torque_i = Vec3{res.torque_i.x[lane], res.torque_i.y[lane], res.torque_i.z[lane]};
+      r.torque_j = Vec3{res.torque_j.x[lane], res.torque_j.y[lane], res.torque_j.z[lane]};
     }
   }
 
