@@ -16,6 +16,7 @@ from demcal.core.parameters import (
 )
 from demcal.core.provenance import write_sidecar
 from demcal.core.rule_log import rule_log
+from demcal.design.cases import design_id, replicate_of
 
 #: Contact and geometry parameters a case may carry (LIGGGHTS names).
 PARAMETERS = (*CONTACT_PARAMETERS, *OPTIONAL_CONTACT_PARAMETERS, *GEOMETRY_PARAMETERS)
@@ -69,7 +70,7 @@ def case_rows(
             rows[out] = math.nan
     rows["test"] = test
     rows["case_id"] = case["case_id"]
-    rows["design_id"] = case["case_id"].split("_s")[0]
+    rows["design_id"] = design_id(case["case_id"])
     for name in PARAMETERS:
         if name in case:
             rows[name] = float(case[name])
@@ -95,6 +96,39 @@ def usable(data: pd.DataFrame, output: str) -> pd.DataFrame:
     """Rows fit for training on ``output``: the run succeeded and the value is finite."""
     ok = (data["status"] == "ok") & data[output].notna()
     return data[ok]
+
+
+def replicate_means(rows: pd.DataFrame, output: str) -> pd.DataFrame:
+    """One row per case and load condition: the mean of ``output`` over the case's replicate
+    runs (``design.replicates``; ids ``c0003_r2_s1_p1`` ...).
+
+    Parameters
+    ----------
+    rows : DataFrame
+        Usable rows (:func:`usable`) of one test, with ``case_id``.
+    output : str
+        The bulk value averaged.
+
+    Returns
+    -------
+    DataFrame
+        ``rows`` where no case has replicates (or no ``case_id``); otherwise the first row of
+        every case and load condition (``case_id`` without the replicate number) with the mean
+        ``output`` and the number of runs averaged in ``replicates``.
+    """
+    if "case_id" not in rows:
+        return rows
+    case = rows["case_id"].astype(str).map(lambda cid: replicate_of(cid)[0])
+    if case.equals(rows["case_id"].astype(str)):
+        return rows
+    keys = [case.rename("_case")] + [rows[c] for c in ("normal_stress", "P") if c in rows]
+    grouped = rows[output].groupby(keys, sort=False, dropna=False)
+    first = ~pd.concat(keys, axis=1).duplicated()
+    out = rows[first].copy()
+    out[output] = grouped.transform("mean")[first].to_numpy()
+    out["replicates"] = grouped.transform("size")[first].to_numpy()
+    out["case_id"] = case[first].to_numpy()
+    return out
 
 
 def write_case_rows(

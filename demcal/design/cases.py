@@ -2,8 +2,10 @@
 
 A shear-cell case is a design row at one pre-shear normal stress and, by default, one shear
 load P (``c0003_s2_p1``); with ``shear_cell.separate_runs: false`` all P values run as cycles
-in one deck (``c0003_s2``). An angle-of-repose case is a design row (``c0003``). Wildcards
-carry these ids, never floats.
+in one deck (``c0003_s2``). An angle-of-repose case is a design row (``c0003``). With
+``design.replicates`` = k > 1 every case also runs as replicates ``c0003_r2_s2_p1`` ...
+``c0003_r<k>_s2_p1`` (``c0003_r2`` ... for the angle of repose), each from its own packing.
+Wildcards carry these ids, never floats.
 """
 
 import re
@@ -19,6 +21,8 @@ from demcal.design.table import CASE_ID_COLUMN, write_design_table
 from demcal.design.table import case_ids as numbered_ids
 
 _SHEAR_KEY = re.compile(r"[A-Za-z0-9]+_s(?P<s>\d+)(_p(?P<p>\d+))?")
+# A replicate's number follows the design row's id, before any load suffix.
+_REPLICATE_PART = re.compile(r"_r(?P<r>[1-9]\d*)(?=_s\d|$)")
 
 # Keys of the design config section that each kind of design reads.
 _KEYS_BY_KIND = {
@@ -27,6 +31,46 @@ _KEYS_BY_KIND = {
     "lhs": ("kind", "n", "seed", "ranges", "choices", "fixed"),
     "sobol": ("kind", "n", "seed", "ranges", "choices", "fixed"),
 }
+
+
+def design_replicates(config: Mapping[str, Any]) -> int:
+    """DEM runs of every design case (``design.replicates``, 1 when absent)."""
+    return int(config["design"].get("replicates", 1))
+
+
+def with_replicates(
+    config: Mapping[str, Any], bases: list[str], suffixes: list[str] | None = None
+) -> list[str]:
+    """Case ids of design rows ``bases`` with load ``suffixes`` (none: the angle of repose),
+    each case followed by its replicate runs (``c0003_r2_s1_p1`` ...)."""
+    k = design_replicates(config)
+    return [
+        f"{base}{'' if r == 1 else f'_r{r}'}{suffix}"
+        for base in bases
+        for suffix in (suffixes or [""])
+        for r in range(1, k + 1)
+    ]
+
+
+def replicate_of(case_id: str) -> tuple[str, int]:
+    """The case a run id replicates and the replicate's number (1 for the case itself).
+
+    Examples
+    --------
+    >>> replicate_of("c0003_r3_s2_p1")
+    ('c0003_s2_p1', 3)
+    >>> replicate_of("c0003")
+    ('c0003', 1)
+    """
+    match = _REPLICATE_PART.search(case_id)
+    if match is None:
+        return case_id, 1
+    return case_id[: match.start()] + case_id[match.end() :], int(match.group("r"))
+
+
+def design_id(case_id: str) -> str:
+    """The design row (parameter set) of a run id: ``c0003`` for ``c0003_r2_s2_p1``."""
+    return replicate_of(case_id)[0].split("_s")[0]
 
 
 def design_spec(section: Mapping[str, Any]) -> dict[str, Any]:
@@ -95,12 +139,13 @@ def case_ids(config: Mapping[str, Any], design: pd.DataFrame, test: str) -> list
     Shear-cell cases run one pre-shear stress (``_s<k>``) and, with
     ``shear_cell.separate_runs``, one shear load P per deck (``_p<j>``); otherwise all P
     values run as cycles in one deck. The last ``design.repose_extra_sets`` rows of the design
-    run only the angle of repose.
+    run only the angle of repose. Every case is followed by its replicate runs
+    (:func:`with_replicates`).
     """
     if test == "angle_of_repose":
-        return list(design[CASE_ID_COLUMN])
+        return with_replicates(config, list(design[CASE_ID_COLUMN]))
     shared = design[CASE_ID_COLUMN].iloc[: len(design) - repose_extra_sets(config)]
-    return [f"{cid}{suffix}" for cid in shared for suffix in shear_suffixes(config)]
+    return with_replicates(config, list(shared), shear_suffixes(config))
 
 
 def shear_suffixes(config: Mapping[str, Any]) -> list[str]:
@@ -114,7 +159,7 @@ def shear_suffixes(config: Mapping[str, Any]) -> list[str]:
 
 def load_condition(config: Mapping[str, Any], key: str) -> dict[str, float]:
     """normal_stress (and P for a separate-run case) encoded in a shear-cell case id."""
-    match = _SHEAR_KEY.fullmatch(key)
+    match = _SHEAR_KEY.fullmatch(replicate_of(key)[0])
     if match is None:
         raise KeyError(f"shear-cell case {key!r} has no _s<k> suffix")
     cell = config["shear_cell"]
@@ -131,19 +176,23 @@ def load_condition(config: Mapping[str, Any], key: str) -> dict[str, float]:
 
 
 def case_row(config: Mapping[str, Any], design: pd.DataFrame, test: str, key: str) -> dict:
-    """The parameters of one case: its design row, plus the load condition for the shear cell.
+    """The parameters of one case: its design row, plus the load condition for the shear cell
+    and, for a replicate run (``c0003_r2_s1_p1``), its insertion seed (:func:`seed_of_replicate`).
 
     Raises
     ------
     KeyError
         When ``key`` is not a case of the design.
     """
-    base = key.split("_s")[0]
+    base = design_id(key)
     rows = design[design["case_id"] == base]
     if rows.empty:
         raise KeyError(f"case {key!r} is not in the design")
     row = {k: (v.item() if hasattr(v, "item") else v) for k, v in rows.iloc[0].items()}
     row["case_id"] = key
+    replicate = replicate_of(key)[1]
+    if replicate > 1:
+        row["seed"] = seed_of_replicate(config, replicate)
     if test == "shear_cell":
         row.update(load_condition(config, key))
     return row

@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from demcal.core.experiments import Experiment
+from demcal.design.cases import design_id
 from demcal.identification.verification import verification_table
 from demcal.sequential.rounds import (
     design_ranges,
@@ -81,7 +82,7 @@ def reuse_cases(source: str | Path, target: str | Path) -> None:
     wanted = set(pd.read_csv(target / "results" / "design" / "cases.csv")["case_id"])
     now = time.time()
     for case in cases.glob("*/*"):
-        if case.name.split("_s")[0] not in wanted:
+        if design_id(case.name) not in wanted:
             continue
         dest = target / "results" / "cases" / case.parent.name / case.name
         shutil.copytree(case, dest, dirs_exist_ok=True)

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from demcal.bulk.dataset import usable
+from demcal.bulk.dataset import replicate_means, usable
 from demcal.core.experiments import Experiment
 from demcal.surrogates.baselines import gaussian_process_regression
 from demcal.surrogates.training import INPUTS, TEST_OF, varying_features
@@ -115,7 +115,7 @@ class BulkProcesses:
         self.models: dict[str, tuple[object, list[str]]] = {}
         self.constants = {k: dict(v) for k, v in constants.items()}
         for output in dict.fromkeys(outputs):
-            rows = usable(data[data["test"] == TEST_OF[output]], output)
+            rows = replicate_means(usable(data[data["test"] == TEST_OF[output]], output), output)
             if len(rows) < 3:
                 raise ValueError(
                     f"{output}: {len(rows)} usable DEM results; at least 3 are needed to "

@@ -29,7 +29,12 @@ import numpy as np
 import pandas as pd
 
 from demcal.bulk.dataset import collect
-from demcal.design.cases import shear_suffixes, verification_bases
+from demcal.design.cases import (
+    design_replicates,
+    shear_suffixes,
+    verification_bases,
+    with_replicates,
+)
 
 #: Quantiles of the valid sets that bound the valid box per parameter.
 BOX_QUANTILES = (0.05, 0.95)
@@ -82,21 +87,23 @@ def round_bases(config: Mapping[str, Any], round_no: int) -> list[str]:
 
 
 def round_case_ids(config: Mapping[str, Any], round_no: int, test: str) -> list[str]:
-    """Case ids (``c0009`` or ``c0009_s1_p2``) of one test in round ``round_no``."""
+    """Case ids (``c0009`` or ``c0009_s1_p2``, and their replicates) of one test in round
+    ``round_no``."""
     bases = round_bases(config, round_no)
     if test == "angle_of_repose":
-        return bases
-    return [f"{b}{s}" for b in bases for s in shear_suffixes(config)]
+        return with_replicates(config, bases)
+    return with_replicates(config, bases, shear_suffixes(config))
 
 
 def runs_per_set(config: Mapping[str, Any]) -> int:
-    """DEM runs of one parameter set: its shear-cell decks and one heap."""
-    return len(shear_suffixes(config)) + 1
+    """DEM runs of one parameter set: its shear-cell decks and one heap, each
+    ``design.replicates`` times."""
+    return (len(shear_suffixes(config)) + 1) * design_replicates(config)
 
 
 def verification_runs(config: Mapping[str, Any]) -> int:
     """DEM runs of one verification (every replicate of every deck)."""
-    return len(verification_bases(config)) * runs_per_set(config)
+    return len(verification_bases(config)) * (len(shear_suffixes(config)) + 1)
 
 
 def round_dataset(

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from demcal.bulk.dataset import PARAMETERS, usable
+from demcal.bulk.dataset import PARAMETERS, replicate_means, usable
 from demcal.core.provenance import write_sidecar
 from demcal.surrogates.baselines import baseline_predictions
 from demcal.surrogates.cross_validation import (
@@ -118,7 +118,7 @@ def train_output(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    rows = usable(data[data["test"] == TEST_OF[output]], output)
+    rows = replicate_means(usable(data[data["test"] == TEST_OF[output]], output), output)
     if len(rows) < 6:
         raise ValueError(
             f"{output}: only {len(rows)} usable DEM results; at least 6 are needed to train"

@@ -20,7 +20,7 @@ from demcal.design.build import (
     sobol_design,
 )
 from demcal.design.cases import case_ids as study_case_ids
-from demcal.design.cases import design_from_config
+from demcal.design.cases import case_row, design_from_config, design_id, replicate_of
 from demcal.design.table import (
     DesignSpecError,
     DesignTableError,
@@ -346,3 +346,30 @@ def test_heap_only_sets_follow_the_shared_sets() -> None:
     assert len(design_from_config(paper)) == 3 * 3 * 3 * 3 * 4
     sequential = {**quick, "sequential": {**quick["sequential"], "enabled": True}}
     assert len(design_from_config(sequential)) == n
+
+
+def test_replicates_follow_every_case_from_their_own_packing() -> None:
+    root = Path(__file__).resolve().parents[2]
+    quick = load_config(root / "config" / "config.yaml")
+    assert quick["design"]["replicates"] == 1
+    design = design_from_config(quick)
+    one = {t: study_case_ids(quick, design, t) for t in ("angle_of_repose", "shear_cell")}
+    three = {**quick, "design": {**quick["design"], "replicates": 3}}
+    pd.testing.assert_frame_equal(design_from_config(three), design)
+    heaps = study_case_ids(three, design, "angle_of_repose")
+    assert heaps[:4] == ["c0001", "c0001_r2", "c0001_r3", "c0002"]
+    assert len(heaps) == 3 * len(one["angle_of_repose"])
+    shear = study_case_ids(three, design, "shear_cell")
+    assert shear[:4] == ["c0001_s1", "c0001_r2_s1", "c0001_r3_s1", "c0001_s2"]
+    assert [c for c in shear if "_r" not in c] == one["shear_cell"]
+    assert replicate_of("c0012_r3_s2") == ("c0012_s2", 3)
+    assert replicate_of("c0012_s2") == ("c0012_s2", 1)
+    assert replicate_of("identified2_s1_p1") == ("identified2_s1_p1", 1)
+    assert design_id("c0012_r3_s2") == design_id("c0012_r3") == design_id("c0012") == "c0012"
+    # A replicate is its design row at the same load, with seed + (k - 1) x 1000.
+    first = case_row(three, design, "shear_cell", "c0005_s2")
+    third = case_row(three, design, "shear_cell", "c0005_r3_s2")
+    assert "seed" not in first
+    assert third.pop("seed") == quick["seed"] + 2000
+    assert {**third, "case_id": "c0005_s2"} == first
+    assert case_row(three, design, "angle_of_repose", "c0005_r2")["seed"] == quick["seed"] + 1000

@@ -11,7 +11,7 @@ import pytest
 import torch
 import yaml
 
-from demcal.bulk.dataset import case_rows, collect, usable
+from demcal.bulk.dataset import case_rows, collect, replicate_means, usable
 from demcal.core.config import ConfigError, validate_config
 from demcal.core.experiments import Experiment, MeasuredCondition, load_experiment
 from demcal.design.cases import (
@@ -156,6 +156,44 @@ def test_case_rows_ok_and_failed(tmp_path):
     data = collect([ok, bad])
     assert list(data.columns[:3]) == ["test", "case_id", "design_id"]
     assert len(usable(data, "mu_psh")) == 2
+
+
+def test_replicate_runs_train_as_their_mean(tmp_path):
+    def extract_with(values):
+        def extract(test, case_dir):
+            return pd.DataFrame(
+                {
+                    "case_id": ["x"] * 2,
+                    "normal_stress": [2029.0] * 2,
+                    "P": [0.6, 1.0],
+                    "mu_psh": values,
+                    "mu_sh": [0.5, 0.6],
+                    "rho_b": [1700.0, 1701.0],
+                }
+            )
+
+        return extract
+
+    runs = [
+        ("c0001_s2", "ok", [0.60, 0.70]),
+        ("c0001_r2_s2", "ok", [0.64, 0.74]),
+        ("c0001_r3_s2", "failed", [0.0, 0.0]),
+        ("c0002_s2", "ok", [0.50, 0.55]),
+    ]
+    data = collect(
+        case_rows("shear_cell", _case_dir(tmp_path, cid, status), extract_with(v), [0.6, 1.0])
+        for cid, status, v in runs
+    )
+    assert set(data["design_id"]) == {"c0001", "c0002"}
+    rows = replicate_means(usable(data, "mu_psh"), "mu_psh")
+    # One row per case and load: the failed third run is left out of the mean.
+    assert rows["case_id"].tolist() == ["c0001_s2", "c0001_s2", "c0002_s2", "c0002_s2"]
+    assert rows["P"].tolist() == [0.6, 1.0, 0.6, 1.0]
+    assert rows["mu_psh"].tolist() == pytest.approx([0.62, 0.72, 0.50, 0.55], abs=1e-12)
+    assert rows["replicates"].tolist() == [2, 2, 1, 1]
+    # Without replicates the rows are returned as they are.
+    plain = usable(data[~data["case_id"].str.contains("_r")], "mu_psh")
+    pd.testing.assert_frame_equal(replicate_means(plain, "mu_psh"), plain)
 
 
 def test_load_experiment_partial_and_invalid(tmp_path):

@@ -9,6 +9,7 @@ from demcal.design.cases import (
     case_ids,
     case_row,
     design_from_config,
+    design_id,
     verification_case_ids,
     verification_engines,
     verification_threads,
@@ -63,7 +64,7 @@ def case_design(wildcards):
     """The design table of a case that a later round of a sequential study chose (none for the
     configured design, which is known when the workflow is parsed)."""
     if SEQUENTIAL:
-        round_no = round_of_case(config, wildcards.case.split("_s")[0])
+        round_no = round_of_case(config, design_id(wildcards.case))
         if round_no > 0:
             return {"design": round_path(round_no, "design.csv")}
     return {}
