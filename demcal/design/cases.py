@@ -38,6 +38,11 @@ def design_replicates(config: Mapping[str, Any]) -> int:
     return int(config["design"].get("replicates", 1))
 
 
+def replicate_bases(run: str, count: int) -> list[str]:
+    """Ids of ``count`` replicates of ``run``: ``run``, ``run_r2``, ..."""
+    return [run] + [f"{run}_r{k}" for k in range(2, int(count) + 1)]
+
+
 def with_replicates(
     config: Mapping[str, Any], bases: list[str], suffixes: list[str] | None = None
 ) -> list[str]:
@@ -45,10 +50,10 @@ def with_replicates(
     each case followed by its replicate runs (``c0003_r2_s1_p1`` ...)."""
     k = design_replicates(config)
     return [
-        f"{base}{'' if r == 1 else f'_r{r}'}{suffix}"
+        f"{replicate}{suffix}"
         for base in bases
         for suffix in (suffixes or [""])
-        for r in range(1, k + 1)
+        for replicate in replicate_bases(base, k)
     ]
 
 

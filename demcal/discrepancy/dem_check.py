@@ -20,7 +20,7 @@ from typing import Any
 
 from demcal.core.config import ConfigError
 from demcal.core.experiments import Experiment
-from demcal.design.cases import load_condition, seed_of_replicate
+from demcal.design.cases import load_condition, replicate_bases, seed_of_replicate
 
 __all__ = [
     "RunId",
@@ -84,11 +84,6 @@ def parse_run_id(case_id: str) -> RunId:
     return RunId(
         match.group("run"), replicate, match.group("load") or "", int(held) if held else None
     )
-
-
-def replicate_bases(run: str, count: int) -> list[str]:
-    """Ids of ``count`` replicates of ``run``: ``run``, ``run_r2``, ..."""
-    return [run] + [f"{run}_r{k}" for k in range(2, int(count) + 1)]
 
 
 def run_seed(config: Mapping[str, Any], case_id: str) -> int:

@@ -95,15 +95,19 @@ def round_case_ids(config: Mapping[str, Any], round_no: int, test: str) -> list[
     return with_replicates(config, bases, shear_suffixes(config))
 
 
+def decks_per_set(config: Mapping[str, Any]) -> int:
+    """Decks of one parameter set: its shear-cell decks and one heap."""
+    return len(shear_suffixes(config)) + 1
+
+
 def runs_per_set(config: Mapping[str, Any]) -> int:
-    """DEM runs of one parameter set: its shear-cell decks and one heap, each
-    ``design.replicates`` times."""
-    return (len(shear_suffixes(config)) + 1) * design_replicates(config)
+    """DEM runs of one parameter set: each of its decks ``design.replicates`` times."""
+    return decks_per_set(config) * design_replicates(config)
 
 
 def verification_runs(config: Mapping[str, Any]) -> int:
     """DEM runs of one verification (every replicate of every deck)."""
-    return len(verification_bases(config)) * (len(shear_suffixes(config)) + 1)
+    return len(verification_bases(config)) * decks_per_set(config)
 
 
 def round_dataset(

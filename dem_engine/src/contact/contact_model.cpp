@@ -107,6 +107,13 @@ DEM_INLINE P lanes_of(F f) {
   }
 }
 
+// A pack of vectors whose lane l is the vector f(l).
+template <class P, class F>
+DEM_INLINE Vec3T<P> vec3_lanes(F f) {
+  return {lanes_of<P>([&](int l) { return f(l).x; }), lanes_of<P>([&](int l) { return f(l).y; }),
+          lanes_of<P>([&](int l) { return f(l).z; })};
+}
+
 // The material parameters of the pack's contacts, lane l from q[l].
 template <class P>
 DEM_INLINE PairParamsT<P> pack_params(const PairParams* const* q) {
@@ -237,9 +244,7 @@ class ComposedModel final : public ContactModel {
       return lanes_of<Pack>([&](int l) { return of[idx[l]]; });
     };
     auto pack3 = [&](const Vec3* of, const std::size_t* idx) DEM_INLINE_LAMBDA {
-      return V{lanes_of<Pack>([&](int l) { return of[idx[l]].x; }),
-               lanes_of<Pack>([&](int l) { return of[idx[l]].y; }),
-               lanes_of<Pack>([&](int l) { return of[idx[l]].z; })};
+      return vec3_lanes<Pack>([&](int l) -> const Vec3& { return of[idx[l]]; });
     };
     // The partners' positions, velocities and spins.
     V xj, vj, wj;
@@ -253,9 +258,7 @@ class ComposedModel final : public ContactModel {
         pw[l] = (ghost ? g.omega : w) + at;
       }
       auto pack3_at = [&](const Vec3* const* of) DEM_INLINE_LAMBDA {
-        return V{lanes_of<Pack>([&](int l) { return of[l]->x; }),
-                 lanes_of<Pack>([&](int l) { return of[l]->y; }),
-                 lanes_of<Pack>([&](int l) { return of[l]->z; })};
+        return vec3_lanes<Pack>([&](int l) -> const Vec3& { return *of[l]; });
       };
       xj = pack3_at(px);
       vj = pack3_at(pv);
@@ -369,32 +372,27 @@ class ComposedModel final : public ContactModel {
       w[l] = &contacts[e0 + std::min(static_cast<std::size_t>(l), count - 1)];
       i[l] = w[l]->i;
     }
-    auto pack1 = [&](auto of) DEM_INLINE_LAMBDA { return lanes_of<Pack>(of); };
-    auto pack3 = [&](auto of) DEM_INLINE_LAMBDA {
-      return V{lanes_of<Pack>([&](int l) { return of(l).x; }),
-               lanes_of<Pack>([&](int l) { return of(l).y; }),
-               lanes_of<Pack>([&](int l) { return of(l).z; })};
-    };
     ContactInputT<Pack> c;
     c.wall = true;
-    c.n = pack3([&](int l) -> const Vec3& { return w[l]->normal; });
-    c.overlap = pack1([&](int l) { return w[l]->overlap; });
-    c.dist = pack1([&](int l) { return w[l]->dist; });
-    c.ri = pack1([&](int l) { return P.radius[i[l]]; });
+    c.n = vec3_lanes<Pack>([&](int l) -> const Vec3& { return w[l]->normal; });
+    c.overlap = lanes_of<Pack>([&](int l) { return w[l]->overlap; });
+    c.dist = lanes_of<Pack>([&](int l) { return w[l]->dist; });
+    c.ri = lanes_of<Pack>([&](int l) { return P.radius[i[l]]; });
     c.rj = 0.0;
     c.r_eff = c.ri;
-    c.m_eff = pack1([&](int l) { return P.rmass[i[l]]; });
+    c.m_eff = lanes_of<Pack>([&](int l) { return P.rmass[i[l]]; });
     c.cri = c.ri - 0.5 * c.overlap;
     c.crj = 0.0;
-    c.v_rel = pack3([&](int l) -> const Vec3& { return P.v[i[l]]; }) -
-              pack3([&](int l) -> const Vec3& { return w[l]->wall_velocity; });
-    c.omega_i = pack3([&](int l) -> const Vec3& { return P.omega[i[l]]; });
+    c.v_rel = vec3_lanes<Pack>([&](int l) -> const Vec3& { return P.v[i[l]]; }) -
+              vec3_lanes<Pack>([&](int l) -> const Vec3& { return w[l]->wall_velocity; });
+    c.omega_i = vec3_lanes<Pack>([&](int l) -> const Vec3& { return P.omega[i[l]]; });
     c.omega_j = V{Pack(0.0), Pack(0.0), Pack(0.0)};
     const PairParams* pair[kLanes];
     for (int l = 0; l < kLanes; ++l) pair[l] = &material.get(P.type[i[l]], w[l]->wall_type);
     const PairParamsT<Pack> p = pack_params<Pack>(pair);
     Pack hist[kHistorySize];
-    for (int q = 0; q < kHistorySize; ++q) hist[q] = pack1([&](int l) { return w[l]->history[q]; });
+    for (int q = 0; q < kHistorySize; ++q)
+      hist[q] = lanes_of<Pack>([&](int l) { return w[l]->history[q]; });
     ContactResultT<Pack> res;
     contact_law<Cohesion, Rolling>(c, p, step, hist, res);
     for (std::size_t l = 0; l < count; ++l) {

@@ -37,19 +37,23 @@
 // function rounds exactly as the other copies.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
 #define DEM_AVX512 __attribute__((target("avx512f")))
-// DEM_ENGINE_NO_AVX512 set (to anything) keeps the four-lane copies on such a CPU too, so the
-// two can be compared on one machine.
+#else
+#define DEM_AVX512
+#endif
+
+namespace dem {
+
+// Whether the DEM_AVX512 copies run. DEM_ENGINE_NO_AVX512 set (to anything) keeps the
+// four-lane copies on such a CPU too, so the two can be compared on one machine.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
 inline bool avx512_cpu() {
   static const bool use =
       __builtin_cpu_supports("avx512f") && std::getenv("DEM_ENGINE_NO_AVX512") == nullptr;
   return use;
 }
 #else
-#define DEM_AVX512
 inline bool avx512_cpu() { return false; }
 #endif
-
-namespace dem {
 
 // Two doubles processed in lockstep (one SSE2 instruction on x86-64, which every x86-64 CPU has;
 // plain lane loops elsewhere). Add, subtract, multiply, divide and sqrt are correctly rounded
