@@ -135,19 +135,26 @@ def _case_dir(tmp_path, name, status, test="shear_cell"):
     return d
 
 
-def test_case_rows_ok_and_failed(tmp_path):
+def _shear_extract(mu_psh):
+    """A bulk extractor giving two shear loads with these mu_psh values."""
+
     def extract(test, case_dir):
         return pd.DataFrame(
             {
                 "case_id": ["x"] * 2,
                 "normal_stress": [2029.0] * 2,
                 "P": [0.6, 1.0],
-                "mu_psh": [0.6, 0.61],
+                "mu_psh": mu_psh,
                 "mu_sh": [0.5, 0.6],
                 "rho_b": [1700.0, 1701.0],
             }
         )
 
+    return extract
+
+
+def test_case_rows_ok_and_failed(tmp_path):
+    extract = _shear_extract([0.6, 0.61])
     ok = case_rows("shear_cell", _case_dir(tmp_path, "c0001_s2", "ok"), extract, [0.6, 1.0])
     bad = case_rows("shear_cell", _case_dir(tmp_path, "c0002_s2", "failed"), extract, [0.6, 1.0])
     assert list(ok["status"]) == ["ok", "ok"] and ok["design_id"].iloc[0] == "c0001"
@@ -159,21 +166,6 @@ def test_case_rows_ok_and_failed(tmp_path):
 
 
 def test_replicate_runs_train_as_their_mean(tmp_path):
-    def extract_with(values):
-        def extract(test, case_dir):
-            return pd.DataFrame(
-                {
-                    "case_id": ["x"] * 2,
-                    "normal_stress": [2029.0] * 2,
-                    "P": [0.6, 1.0],
-                    "mu_psh": values,
-                    "mu_sh": [0.5, 0.6],
-                    "rho_b": [1700.0, 1701.0],
-                }
-            )
-
-        return extract
-
     runs = [
         ("c0001_s2", "ok", [0.60, 0.70]),
         ("c0001_r2_s2", "ok", [0.64, 0.74]),
@@ -181,7 +173,7 @@ def test_replicate_runs_train_as_their_mean(tmp_path):
         ("c0002_s2", "ok", [0.50, 0.55]),
     ]
     data = collect(
-        case_rows("shear_cell", _case_dir(tmp_path, cid, status), extract_with(v), [0.6, 1.0])
+        case_rows("shear_cell", _case_dir(tmp_path, cid, status), _shear_extract(v), [0.6, 1.0])
         for cid, status, v in runs
     )
     assert set(data["design_id"]) == {"c0001", "c0002"}
