@@ -131,6 +131,65 @@ def replicate_means(rows: pd.DataFrame, output: str) -> pd.DataFrame:
     return out
 
 
+def collapse_shared_loads(rows: pd.DataFrame, output: str) -> pd.DataFrame:
+    """One row per deck (case and normal stress) where ``output`` does not depend on P.
+
+    With ``shear_cell.cycles: continue`` a deck's mu_psh and rho_b are its pre-shear point, read
+    once over all its cycles and repeated on the row of every P. Those copies are not
+    independent samples: fed to a surrogate as rows they weight every deck by the number of P
+    values and offer P as an input that carries nothing, which misleads a Gaussian process
+    (its noise level and length scales) and inflates the row counts of Table 4.
+
+    Parameters
+    ----------
+    rows : DataFrame
+        Usable rows of one test (:func:`usable`, :func:`replicate_means`).
+    output : str
+        The bulk value.
+
+    Returns
+    -------
+    DataFrame
+        ``rows`` unchanged when ``output`` differs between the P of any deck, or no deck holds
+        more than one P (one deck per P, or no ``P``); otherwise the first row of every deck,
+        without the ``P`` column.
+    """
+    if "P" not in rows or "case_id" not in rows or rows.empty:
+        return rows
+    keys = [rows[c] for c in ("case_id", "normal_stress") if c in rows]
+    per_deck = rows.groupby(keys, sort=False, dropna=False)
+    spread = per_deck[output].agg(["min", "max"])
+    # With one deck per P (``cycles: separate``) every case holds a single P: nothing repeats.
+    several_p = (per_deck["P"].nunique() > 1).any()
+    if not several_p or not (spread["min"] == spread["max"]).all():
+        return rows
+    return rows[~pd.concat(keys, axis=1).duplicated()].drop(columns="P")
+
+
+def training_rows(data: pd.DataFrame, test: str, output: str) -> pd.DataFrame:
+    """The rows a surrogate of ``output`` learns from: one per independent DEM reading.
+
+    Runs that succeeded with a finite value (:func:`usable`), replicates averaged
+    (:func:`replicate_means`), copies of one per-deck value over P merged
+    (:func:`collapse_shared_loads`).
+
+    Parameters
+    ----------
+    data : DataFrame
+        The tidy bulk dataset.
+    test : {"shear_cell", "angle_of_repose"}
+        The virtual test that measures ``output``.
+    output : str
+        The bulk value.
+
+    Returns
+    -------
+    DataFrame
+    """
+    rows = replicate_means(usable(data[data["test"] == test], output), output)
+    return collapse_shared_loads(rows, output)
+
+
 def write_case_rows(
     test: str,
     info: str | Path,

@@ -23,6 +23,7 @@ from demcal.discrepancy.run_results import read_runs
 from demcal.discrepancy.runs import named_candidate
 from demcal.surrogates.data_split import split_indices
 from demcal.surrogates.hidden_size_sweep import sweep_hidden_sizes
+from demcal.surrogates.log_inputs import log_columns
 from demcal.surrogates.metrics import regression_metrics
 from demcal.surrogates.training import INPUTS, TEST_OF, varying_features
 
@@ -177,6 +178,7 @@ def train_extended_surrogate(
         seed=seed,
         max_epochs=int(settings["max_epochs"]),
         patience=int(settings["patience"]),
+        log_inputs=log_columns(features),
     )
     metrics = regression_metrics(y[test], sweep.model.predict(X[test]))
     metadata = {

@@ -30,9 +30,10 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from demcal.bulk.dataset import replicate_means, usable
+from demcal.bulk.dataset import training_rows
 from demcal.core.experiments import Experiment
 from demcal.surrogates.baselines import gaussian_process_regression
+from demcal.surrogates.log_inputs import log_columns
 from demcal.surrogates.training import INPUTS, TEST_OF, varying_features
 
 #: Unit-cube distance within which a chosen uncertain set damps the others' uncertainty.
@@ -115,14 +116,16 @@ class BulkProcesses:
         self.models: dict[str, tuple[object, list[str]]] = {}
         self.constants = {k: dict(v) for k, v in constants.items()}
         for output in dict.fromkeys(outputs):
-            rows = replicate_means(usable(data[data["test"] == TEST_OF[output]], output), output)
+            rows = training_rows(data, TEST_OF[output], output)
             if len(rows) < 3:
                 raise ValueError(
                     f"{output}: {len(rows)} usable DEM results; at least 3 are needed to "
                     "place the next round"
                 )
             features = varying_features(rows, INPUTS[output])
-            model = gaussian_process_regression(seed, n_restarts_optimizer=1)
+            model = gaussian_process_regression(
+                seed, n_restarts_optimizer=1, log_inputs=log_columns(features)
+            )
             model.fit(rows[features].to_numpy(dtype=float), rows[output].to_numpy(dtype=float))
             self.models[output] = (model, features)
 

@@ -8,6 +8,7 @@ Both are scikit-learn estimators on standardised inputs: Bayesian linear regress
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -20,17 +21,32 @@ from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from demcal.surrogates.log_inputs import log_transformer
 
-def bayesian_linear_regression() -> Pipeline:
+
+def bayesian_linear_regression(log_inputs: Sequence[int] = ()) -> Pipeline:
     """Bayesian linear regression on standardised inputs.
+
+    Parameters
+    ----------
+    log_inputs : sequence of int, default ()
+        Input columns taken as their natural logarithm first
+        (:mod:`demcal.surrogates.log_inputs`).
 
     Returns
     -------
     sklearn.pipeline.Pipeline
-        Steps ``scale`` (StandardScaler) and ``regressor`` (BayesianRidge with default
-        Gamma hyper-priors); predicts in the units of the training target.
+        Steps ``log`` (`log_transformer`), ``scale`` (StandardScaler) and ``regressor``
+        (BayesianRidge with default Gamma hyper-priors); predicts in the units of the training
+        target.
     """
-    return Pipeline([("scale", StandardScaler()), ("regressor", BayesianRidge())])
+    return Pipeline(
+        [
+            ("log", log_transformer(log_inputs)),
+            ("scale", StandardScaler()),
+            ("regressor", BayesianRidge()),
+        ]
+    )
 
 
 def linear_coefficients(model: Pipeline) -> tuple[np.ndarray, float]:
@@ -44,9 +60,11 @@ def linear_coefficients(model: Pipeline) -> tuple[np.ndarray, float]:
     Returns
     -------
     coef : numpy.ndarray, shape (n_features,)
-        d y / d x_j in units of y per unit of x_j.
+        d y / d x_j in units of y per unit of x_j (per unit of ln x_j for a column of the
+        ``log`` step).
     intercept : float
-        Prediction at x = 0, units of y.
+        Prediction where every input of the regression (after the ``log`` step) is 0, units
+        of y.
     """
     scaler = model.named_steps["scale"]
     regressor = model.named_steps["regressor"]
@@ -163,7 +181,9 @@ class AnisotropicGaussianProcess(RegressorMixin, BaseEstimator):
         return self.gp_.predict(X_arr, return_std=return_std)
 
 
-def gaussian_process_regression(seed: int = 0, n_restarts_optimizer: int = 3) -> Pipeline:
+def gaussian_process_regression(
+    seed: int = 0, n_restarts_optimizer: int = 3, log_inputs: Sequence[int] = ()
+) -> Pipeline:
     """Gaussian (process) nonlinear regression on standardised inputs.
 
     Parameters
@@ -172,14 +192,19 @@ def gaussian_process_regression(seed: int = 0, n_restarts_optimizer: int = 3) ->
         Seed of the hyper-parameter optimiser restarts.
     n_restarts_optimizer : int, default 3
         Extra optimiser starts.
+    log_inputs : sequence of int, default ()
+        Input columns taken as their natural logarithm first
+        (:mod:`demcal.surrogates.log_inputs`).
 
     Returns
     -------
     sklearn.pipeline.Pipeline
-        Steps ``scale`` (StandardScaler) and ``regressor`` (`AnisotropicGaussianProcess`).
+        Steps ``log`` (`log_transformer`), ``scale`` (StandardScaler) and ``regressor``
+        (`AnisotropicGaussianProcess`).
     """
     return Pipeline(
         [
+            ("log", log_transformer(log_inputs)),
             ("scale", StandardScaler()),
             (
                 "regressor",
@@ -196,7 +221,11 @@ BASELINES = ("Bayesian", "Gaussian")
 
 
 def baseline_predictions(
-    X_train: npt.ArrayLike, y_train: npt.ArrayLike, X_test: npt.ArrayLike, seed: int = 0
+    X_train: npt.ArrayLike,
+    y_train: npt.ArrayLike,
+    X_test: npt.ArrayLike,
+    seed: int = 0,
+    log_inputs: Sequence[int] = (),
 ) -> dict[str, np.ndarray]:
     """Fit both baselines on the training rows and predict the test rows.
 
@@ -210,6 +239,8 @@ def baseline_predictions(
         Inputs to predict.
     seed : int, default 0
         Seed of the Gaussian-process optimiser restarts.
+    log_inputs : sequence of int, default ()
+        Input columns both baselines take as their natural logarithm.
 
     Returns
     -------
@@ -218,8 +249,8 @@ def baseline_predictions(
         (`gaussian_process_regression`) predictions, units of y.
     """
     models = {
-        "Bayesian": bayesian_linear_regression(),
-        "Gaussian": gaussian_process_regression(seed),
+        "Bayesian": bayesian_linear_regression(log_inputs),
+        "Gaussian": gaussian_process_regression(seed, log_inputs=log_inputs),
     }
     return {
         name: np.asarray(model.fit(X_train, y_train).predict(X_test), dtype=np.float64)

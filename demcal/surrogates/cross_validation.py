@@ -212,6 +212,7 @@ def cross_validate(
     seed: int = 0,
     split: Sequence[float] = (0.7, 0.15, 0.15),
     methods: Sequence[str] = METHODS,
+    log_inputs: Sequence[int] = (),
     **mlp_params: Any,
 ) -> CrossValidation:
     """Grouped K-fold cross-validation of the network and the baselines.
@@ -237,6 +238,9 @@ def cross_validate(
         ``split[1] / (split[0] + split[1])`` of its sets (at least one) to the generalisation set.
     methods : sequence of str, default METHODS
         Methods to run, a subset of ``("Bayesian", "Gaussian", "ANN")``, in output order.
+    log_inputs : sequence of int, default ()
+        Input columns every method takes as their natural logarithm
+        (:mod:`demcal.surrogates.log_inputs`).
     **mlp_params
         Further `MLPSurrogate` parameters, as for the saved model (``max_epochs``,
         ``patience``, ...).
@@ -283,11 +287,21 @@ def cross_validate(
         fold_pred: dict[str, np.ndarray] = {}
         baselines = [m for m in methods if m in BASELINES]
         if baselines:
-            fitted = baseline_predictions(X_arr[train], y_arr[train], X_arr[test], seed)
+            fitted = baseline_predictions(
+                X_arr[train], y_arr[train], X_arr[test], seed, log_inputs=log_inputs
+            )
             fold_pred.update({m: fitted[m] for m in baselines})
         if "ANN" in methods:
             sweep = sweep_hidden_sizes(
-                X_arr, y_arr, train, val, test, sizes=[hidden_size], seed=seed, **mlp_params
+                X_arr,
+                y_arr,
+                train,
+                val,
+                test,
+                sizes=[hidden_size],
+                seed=seed,
+                log_inputs=tuple(log_inputs),
+                **mlp_params,
             )
             fold_pred["ANN"] = sweep.model.predict(X_arr[test])
         counts = {}

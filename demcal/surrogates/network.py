@@ -20,6 +20,7 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from demcal.surrogates.log_inputs import take_logs
 from demcal.surrogates.network_file import load_network, save_network
 from demcal.surrogates.network_training import single_torch_thread, train_lbfgs
 
@@ -34,7 +35,8 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
     """One-hidden-layer tanh network with a linear output, trained with early stopping.
 
     The prediction is ``y = y_mean + y_scale * (w2 . tanh(W1 xs + b1) + b2)`` with
-    ``xs = (x - x_mean) / x_scale``; means and standard deviations come from the training data.
+    ``xs = (x' - x_mean) / x_scale``, where ``x'`` is ``x`` with the natural logarithm of the
+    columns `log_inputs`; means and standard deviations come from the training data.
 
     Parameters
     ----------
@@ -55,6 +57,9 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
         generalisation set.
     random_state : int, numpy RandomState or None, default 0
         Seed of the weight initialisation and of the internal hold-out split.
+    log_inputs : sequence of int, default ()
+        Input columns the network sees as their natural logarithm
+        (:mod:`demcal.surrogates.log_inputs`); inputs are always given in SI units.
 
     Attributes
     ----------
@@ -89,6 +94,7 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
         alpha: float = 0.0,
         validation_fraction: float = 0.15,
         random_state: int | np.random.RandomState | None = 0,
+        log_inputs: tuple[int, ...] = (),
     ) -> None:
         self.hidden_size = hidden_size
         self.max_epochs = max_epochs
@@ -97,6 +103,7 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
         self.alpha = alpha
         self.validation_fraction = validation_fraction
         self.random_state = random_state
+        self.log_inputs = log_inputs
 
     # ------------------------------------------------------------------ fitting
     def _check_params(self) -> None:
@@ -152,6 +159,7 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
         """
         self._check_params()
         X_arr, y_arr = validate_data(self, X, y, dtype=np.float64, y_numeric=True)
+        X_arr = take_logs(X_arr, self.log_inputs)
         n = X_arr.shape[0]
         if n < 2:
             raise ValueError(f"MLPSurrogate needs at least 2 training samples, got n_samples={n}")
@@ -162,6 +170,7 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
             Xv, yv = validate_data(
                 self, X_val, y_val, reset=False, dtype=np.float64, y_numeric=True
             )
+            Xv = take_logs(Xv, self.log_inputs)
             Xt, yt = X_arr, y_arr
         elif n >= 3:
             n_val = min(n - 2, max(1, round(self.validation_fraction * n)))
@@ -236,7 +245,7 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
             Predictions in the units of the training target.
         """
         check_is_fitted(self, "W1_")
-        X_arr = validate_data(self, X, reset=False, dtype=np.float64)
+        X_arr = take_logs(validate_data(self, X, reset=False, dtype=np.float64), self.log_inputs)
         return self.y_mean_ + self.y_scale_ * self._standardised_output(X_arr)
 
     def predict_torch(self, X: torch.Tensor, chunk_size: int = 262_144) -> torch.Tensor:
@@ -248,7 +257,8 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
         Parameters
         ----------
         X : torch.Tensor, shape (n, n_features_in_)
-            Inputs in training units and column order; converted to float32.
+            Inputs in training units and column order (the columns `log_inputs` as they are,
+            not their logarithm); converted to float32.
         chunk_size : int, default 262144
             Rows per chunk; bounds the hidden-layer buffer to chunk_size x hidden_size floats.
 
@@ -271,10 +281,15 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
         W1_t = torch.from_numpy(W1.T.astype(np.float32)).to(X.device)
         b1_t = torch.from_numpy(b1.astype(np.float32)).to(X.device)
         w2_t = torch.from_numpy(w2.astype(np.float32)).to(X.device)
+        logs = list(self.log_inputs)
         out = torch.empty(X.shape[0], dtype=torch.float32, device=X.device)
         with torch.no_grad():
             for start in range(0, X.shape[0], chunk_size):
                 chunk = X[start : start + chunk_size].to(torch.float32)
+                if logs:
+                    # A copy: the caller's grid must keep its SI values.
+                    chunk = chunk.clone()
+                    chunk[:, logs] = chunk[:, logs].log()
                 hidden = torch.addmm(b1_t, chunk, W1_t).tanh_()
                 torch.mv(hidden, w2_t, out=out[start : start + chunk_size])
             out.add_(float(b2))

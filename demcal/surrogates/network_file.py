@@ -58,6 +58,8 @@ def save_network(
             params[key] = int(value)
         elif isinstance(value, float | np.floating):
             params[key] = float(value)
+        elif key == "log_inputs":
+            params[key] = [int(c) for c in value]
         elif key == "random_state":
             # A RandomState (or None) cannot reproduce the fit; the seed it gave can.
             params[key] = int(model.seed_)
@@ -146,7 +148,10 @@ def load_network(cls: type[MLPSurrogate], path: str | Path) -> MLPSurrogate:
     for key in (*_WEIGHT_KEYS, "params", "n_features_in", "seed", "training"):
         if key not in state:
             raise KeyError(f"{path}: missing entry {key!r}")
-    model = cls(**state["params"])
+    params = dict(state["params"])
+    if "log_inputs" in params:
+        params["log_inputs"] = tuple(int(c) for c in params["log_inputs"])
+    model = cls(**params)
     model.n_features_in_ = int(state["n_features_in"])
     if state.get("feature_names") is not None:
         model.feature_names_in_ = np.asarray(state["feature_names"], dtype=object)

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from demcal.bulk.dataset import PARAMETERS, replicate_means, usable
+from demcal.bulk.dataset import PARAMETERS, training_rows
 from demcal.core.provenance import write_sidecar
 from demcal.surrogates.baselines import baseline_predictions
 from demcal.surrogates.cross_validation import (
@@ -24,6 +24,7 @@ from demcal.surrogates.cross_validation import (
 from demcal.surrogates.data_split import split_groups
 from demcal.surrogates.figures import parity_plot, r2_vs_hidden_size
 from demcal.surrogates.hidden_size_sweep import SweepResult, sweep_hidden_sizes
+from demcal.surrogates.log_inputs import log_columns
 from demcal.surrogates.metrics import regression_metrics
 from demcal.surrogates.network import MLPSurrogate
 from demcal.surrogates.table4 import SPLIT_PARTS, method_rows, section_markdown
@@ -118,7 +119,7 @@ def train_output(
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    rows = replicate_means(usable(data[data["test"] == TEST_OF[output]], output), output)
+    rows = training_rows(data, TEST_OF[output], output)
     if len(rows) < 6:
         raise ValueError(
             f"{output}: only {len(rows)} usable DEM results; at least 6 are needed to train"
@@ -134,12 +135,13 @@ def train_output(
     # Split by parameter set: the load conditions of one set are not independent samples.
     train, val, test = split_groups(groups, seed, tuple(settings["split"]))
     lo, hi = settings["hidden_sizes"]
+    logs = log_columns(features)
     mlp_params = {"max_epochs": int(settings["max_epochs"]), "patience": int(settings["patience"])}
     sweep = sweep_hidden_sizes(
-        X, y, train, val, test, sizes=range(lo, hi + 1), seed=seed, **mlp_params
+        X, y, train, val, test, sizes=range(lo, hi + 1), seed=seed, log_inputs=logs, **mlp_params
     )
     sweep.table.to_csv(out_dir / "sweep.csv", index=False)
-    predictions = baseline_predictions(X[train], y[train], X[test], seed)
+    predictions = baseline_predictions(X[train], y[train], X[test], seed, log_inputs=logs)
     predictions["ANN"] = sweep.model.predict(X[test])
     test_metrics = {m: regression_metrics(y[test], predictions[m]) for m in METHODS}
     cv = None
@@ -152,6 +154,7 @@ def train_output(
             hidden_size=sweep.selected_size,
             seed=seed,
             split=tuple(settings["split"]),
+            log_inputs=logs,
             **mlp_params,
         )
         cv_table = cv.folds
@@ -187,6 +190,7 @@ def train_output(
         metadata={
             "output": output,
             "features": features,
+            "log_features": [features[k] for k in logs],
             "n_samples": len(rows),
             "split_sizes": [len(train), len(val), len(test)],
             "split_sets": [counts[p][0] for p in SPLIT_PARTS],

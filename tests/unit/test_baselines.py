@@ -93,3 +93,29 @@ def test_sklearn_estimator_checks(estimator: object, check: functools.partial[No
         # skipped to keep the run short (each costs several GP fits on 200 x 10 samples).
         pytest.skip("read-only memmap variant of check_regressors_train")
     check(estimator)
+
+
+def test_gaussian_process_on_log_friction_follows_a_steep_then_flat_response():
+    # A response linear in ln(mu_s) (steep at low friction, flat at high), as the bulk friction
+    # of a sphere packing; 16 sets of four inputs, two of which do nothing.
+    rng = np.random.default_rng(0)
+    X = np.c_[
+        rng.uniform(0.1, 1.0, 16),
+        rng.uniform(0.1, 1.0, 16),
+        rng.uniform(0.5, 0.9, 16),
+        rng.uniform(2500.0, 3500.0, 16),
+    ]
+
+    def response(X):
+        return 0.3 * np.log(X[:, 0]) + 0.2 * X[:, 1]
+
+    line = np.c_[np.linspace(0.1, 1.0, 50), np.full((50, 3), [0.5, 0.7, 3000.0])]
+    errors = {}
+    for logs in ((), (0,)):
+        model = gaussian_process_regression(seed=0, log_inputs=logs).fit(X, response(X))
+        errors[logs] = np.sqrt(np.mean((model.predict(line) - response(line)) ** 2))
+    span = np.ptp(response(line))
+    assert errors[(0,)] < 1e-3 * span
+    assert errors[()] > 10.0 * errors[(0,)]
+    with pytest.raises(ValueError, match="must be positive"):
+        gaussian_process_regression(log_inputs=(0,)).fit(X * [0.0, 1, 1, 1], response(X))

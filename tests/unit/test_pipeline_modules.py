@@ -11,7 +11,7 @@ import pytest
 import torch
 import yaml
 
-from demcal.bulk.dataset import case_rows, collect, replicate_means, usable
+from demcal.bulk.dataset import case_rows, collect, replicate_means, training_rows, usable
 from demcal.core.config import ConfigError, validate_config
 from demcal.core.experiments import Experiment, MeasuredCondition, load_experiment
 from demcal.design.cases import (
@@ -186,6 +186,62 @@ def test_replicate_runs_train_as_their_mean(tmp_path):
     # Without replicates the rows are returned as they are.
     plain = usable(data[~data["case_id"].str.contains("_r")], "mu_psh")
     pd.testing.assert_frame_equal(replicate_means(plain, "mu_psh"), plain)
+
+
+def _deck_extract(rho_b, mu_sh, P=(0.6, 1.0)):
+    """A bulk extractor of one deck: rho_b read once and repeated on every P row."""
+
+    def extract(test, case_dir):
+        return pd.DataFrame(
+            {
+                "case_id": ["x"] * len(P),
+                "normal_stress": [2029.0] * len(P),
+                "P": list(P),
+                "mu_psh": [0.55] * len(P),
+                "mu_sh": mu_sh,
+                "rho_b": [rho_b] * len(P),
+            }
+        )
+
+    return extract
+
+
+def test_training_rows_merge_a_decks_value_repeated_over_P(tmp_path):
+    runs = [
+        ("c0001_s2", 1700.0, [0.50, 0.60]),
+        ("c0001_r2_s2", 1720.0, [0.52, 0.58]),
+        ("c0002_s2", 1650.0, [0.40, 0.45]),
+    ]
+    data = collect(
+        case_rows("shear_cell", _case_dir(tmp_path, cid, "ok"), _deck_extract(rho, mu), [0.6, 1.0])
+        for cid, rho, mu in runs
+    )
+    # rho_b is one reading per deck: one row per set and stress, P no longer an input.
+    rho = training_rows(data, "shear_cell", "rho_b")
+    assert rho["case_id"].tolist() == ["c0001_s2", "c0002_s2"]
+    assert "P" not in rho
+    assert rho["rho_b"].tolist() == pytest.approx([1710.0, 1650.0], abs=1e-9)
+    # mu_sh differs between the P of a deck: a row per P, replicates averaged.
+    mu = training_rows(data, "shear_cell", "mu_sh")
+    assert mu["P"].tolist() == [0.6, 1.0, 0.6, 1.0]
+    assert mu["mu_sh"].tolist() == pytest.approx([0.51, 0.59, 0.40, 0.45], abs=1e-12)
+    assert training_rows(data, "angle_of_repose", "rho_b").empty
+
+
+def test_training_rows_keep_P_of_separate_decks(tmp_path):
+    # cycles: separate - one deck per P, each reading its own pre-shear point.
+    frames = [
+        case_rows(
+            "shear_cell",
+            _case_dir(tmp_path, f"c0001_s2_p{j}", "ok"),
+            _deck_extract(rho, [0.5], P=(p,)),
+            [0.6, 1.0],
+        )
+        for j, (p, rho) in enumerate([(0.6, 1700.0), (1.0, 1690.0)], start=1)
+    ]
+    rows = training_rows(collect(frames), "shear_cell", "rho_b")
+    assert rows["P"].tolist() == [0.6, 1.0]
+    assert rows["rho_b"].tolist() == [1700.0, 1690.0]
 
 
 def test_load_experiment_partial_and_invalid(tmp_path):

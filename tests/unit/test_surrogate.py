@@ -18,6 +18,7 @@ from threadpoolctl import threadpool_limits
 from demcal.surrogates.data_split import split_indices
 from demcal.surrogates.figures import parity_plot, r2_vs_hidden_size
 from demcal.surrogates.hidden_size_sweep import sweep_hidden_sizes
+from demcal.surrogates.log_inputs import log_columns
 from demcal.surrogates.metrics import regression_metrics
 from demcal.surrogates.network import MLPSurrogate
 from tests.figures import ink, read_png, saved_figures
@@ -161,6 +162,28 @@ def test_predict_torch_equals_predict() -> None:
     np.testing.assert_allclose(got.numpy(), expected, rtol=0.0, atol=2e-5)
     with pytest.raises(ValueError, match=r"shape \(n, 5\)"):
         model.predict_torch(torch.zeros(3, 4))
+
+
+def test_log_inputs_are_taken_inside_the_network(tmp_path: Path) -> None:
+    X, y = smooth_data(200, seed=11)
+    logs = log_columns(FEATURES)
+    assert logs == (0,)
+    model = MLPSurrogate(hidden_size=10, max_epochs=100, log_inputs=logs)
+    model.fit(X.iloc[:170], y[:170], X_val=X.iloc[170:], y_val=y[170:])
+    # The network standardises ln(mu_s): its input mean is that of the logarithm.
+    assert model.x_mean_[0] == pytest.approx(np.log(X["coefficientFriction"][:170]).mean())
+    grid, _ = smooth_data(500, seed=12)
+    values = torch.tensor(grid.to_numpy())
+    before = values.clone()
+    got = model.predict_torch(values, chunk_size=128)
+    np.testing.assert_allclose(got.numpy(), model.predict(grid), rtol=0.0, atol=2e-5)
+    assert torch.equal(values, before), "the caller's grid must keep its SI values"
+    loaded = MLPSurrogate.load(model.save(tmp_path / "m.pt"))
+    assert loaded.log_inputs == logs
+    assert np.array_equal(loaded.predict(grid), model.predict(grid))
+    bad = X.assign(coefficientFriction=0.0)
+    with pytest.raises(ValueError, match=r"log columns \[0\] must be positive"):
+        model.predict(bad)
 
 
 def test_bad_parameters_and_inputs() -> None:
