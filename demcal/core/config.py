@@ -20,7 +20,7 @@ from typing import Any
 import jsonschema
 import yaml
 
-from demcal.core.parameters import out_of_bounds, unknown_parameter
+from demcal.core.parameters import LOG_SCALE_PARAMETERS, out_of_bounds, unknown_parameter
 
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas"
 
@@ -189,6 +189,31 @@ def parameter_problems(config: Mapping[str, Any]) -> list[str]:
     return problems
 
 
+def _log_scale_problems(config: Mapping[str, Any]) -> list[str]:
+    """Design values of a log-scale parameter that are not above 0.
+
+    The surrogates take the logarithm of these inputs (``LOG_SCALE_PARAMETERS``); a design or
+    screening axis reaching 0 would stop the study at training, after its DEM runs.
+    """
+    design = config.get("design", {})
+    places = [(f"design.{key}", design.get(key, {})) for key in ("ranges", "levels", "choices")]
+    places.append(("screening.axes", config.get("screening", {}).get("axes", {})))
+    problems = []
+    for where, section in places:
+        for name in LOG_SCALE_PARAMETERS:
+            values = section.get(name)
+            if values is None:
+                continue
+            values = values[:2] if where == "screening.axes" else values
+            low = min(values) if isinstance(values, list) else values
+            if isinstance(low, int | float) and low <= 0.0:
+                problems.append(
+                    f"{where}.{name}: must stay above 0, got {low:g} (the surrogates take the "
+                    "logarithm of this input; start the range at e.g. 0.05)"
+                )
+    return problems
+
+
 def _shear_cell_problems(config: Mapping[str, Any]) -> list[str]:
     """Combinations of ``shear_cell`` keys that the schema cannot express."""
     cell = config.get("shear_cell", {})
@@ -221,6 +246,7 @@ def validate_config(config: dict, source: str) -> dict:
     """
     validate(config, "config.schema.yaml", source)
     problems = parameter_problems(config) + _shear_cell_problems(config)
+    problems += _log_scale_problems(config)
     if problems:
         lines = "\n  ".join(problems)
         raise ConfigError(f"{source}: invalid configuration:\n  {lines}")

@@ -148,6 +148,9 @@ CONTACT_PARAMETERS: tuple[str, ...] = (
     "coefficientRestitution",
     "density",
 )
+#: Parameters the surrogates take the natural logarithm of (see
+#: :mod:`demcal.surrogates.log_inputs`): a design that varies them must stay above 0.
+LOG_SCALE_PARAMETERS: tuple[str, ...] = ("coefficientFriction",)
 #: Contact parameters a case may add: SJKR cohesion and a separate particle-wall friction.
 OPTIONAL_CONTACT_PARAMETERS: tuple[str, ...] = ("cohesionEnergyDensity", "wallFriction")
 #: Elastic constants (from the ``material`` configuration unless a case column overrides them).

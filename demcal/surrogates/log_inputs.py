@@ -17,8 +17,10 @@ import numpy as np
 import numpy.typing as npt
 from sklearn.preprocessing import FunctionTransformer
 
+from demcal.core.parameters import LOG_SCALE_PARAMETERS
+
 #: Model inputs taken as their natural logarithm (LIGGGHTS names).
-LOG_INPUTS = ("coefficientFriction",)
+LOG_INPUTS = LOG_SCALE_PARAMETERS
 
 
 def log_columns(features: Sequence[str]) -> tuple[int, ...]:

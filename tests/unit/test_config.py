@@ -179,7 +179,27 @@ def test_every_out_of_bounds_design_value_is_reported_at_once():
         "design.levels.coefficientFriction[0]: coefficientFriction = -0.2 is outside [0, inf)",
         "design.levels.density[1]: density = 0 is outside (0, inf)",
         "design.fixed.cohesionEnergyDensity: cohesionEnergyDensity = -1 is outside [0, inf)",
+        "design.levels.coefficientFriction: must stay above 0, got -0.2 (the surrogates take "
+        "the logarithm of this input; start the range at e.g. 0.05)",
     ]
+
+
+def test_sliding_friction_reaching_zero_is_refused_before_any_run():
+    # Allowed for LIGGGHTS, but the surrogates read ln(mu_s): the study would stop at training.
+    cfg = {
+        "design": {"ranges": {"coefficientFriction": [0.0, 1.0]}},
+        "screening": {"axes": {"coefficientFriction": [0.0, 1.0, 50]}},
+    }
+    with pytest.raises(ConfigError) as err:
+        validate_config(cfg, "x.yaml")
+    lines = [line.strip() for line in str(err.value).splitlines()[1:]]
+    assert [line.split(":")[0] for line in lines] == [
+        "design.ranges.coefficientFriction",
+        "screening.axes.coefficientFriction",
+    ]
+    assert all("must stay above 0, got 0" in line for line in lines)
+    # A fixed value does not vary, is no surrogate input and may be 0.
+    validate_config({"design": {"fixed": {"coefficientFriction": 0.0}}}, "x.yaml")
 
 
 @pytest.mark.parametrize(
