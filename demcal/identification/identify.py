@@ -20,7 +20,7 @@ from demcal.identification.calibration import CalibrationResult, calibrate, writ
 from demcal.identification.figures import box_plot_normalised, cor_density_plot, note_figure
 from demcal.identification.reachability import reach_of_measurements, reach_statement
 from demcal.identification.statistics import table5_markdown, write_table5_csv
-from demcal.surrogates.training import load_surrogate
+from demcal.surrogates.training import load_screening_surrogate
 
 #: Box-plot figures: file key -> (group of valid sets, title).
 BOX_PLOT_FIGURES = {
@@ -57,6 +57,22 @@ class IdentificationFiles:
     fig9: str | Path
 
 
+def screened_with_statement(methods: Mapping[str, str], choice: str) -> str:
+    """One sentence naming the surrogate that screened each bulk value.
+
+    Parameters
+    ----------
+    methods : mapping
+        Bulk value -> Table 4 method (``"ANN"`` or ``"Gaussian"``).
+    choice : str
+        ``surrogate.screen_with``.
+    """
+    names = {"ANN": "network", "Gaussian": "Gaussian process"}
+    parts = ", ".join(f"{value} by its {names[m]}" for value, m in methods.items())
+    rule = " (higher cross-validated R^2)" if choice == "best" else ""
+    return f"screened {parts}{rule}."
+
+
 def identify(
     models: Mapping[str, str | Path],
     experiment_file: str | Path,
@@ -72,7 +88,9 @@ def identify(
     ----------
     models : mapping of str to path
         Bulk value (``mu_psh``, ``mu_sh``, ``rho_b``, ``aor``) -> saved network (``model.pt``
-        with its sidecar).
+        with its sidecar; its Table 4 and Gaussian process beside it). The surrogate that
+        screens is chosen by ``surrogate.screen_with`` of ``config``
+        (:func:`demcal.surrogates.training.load_screening_surrogate`).
     experiment_file : path
         The measured bulk values (``config/experiments/*.yaml``).
     screening : mapping
@@ -93,7 +111,10 @@ def identify(
     CalibrationResult
         Valid sets per group, Table 5 and the identified set.
     """
-    surrogates = {name: load_surrogate(path) for name, path in models.items()}
+    choice = str(config.get("surrogate", {}).get("screen_with", "network"))
+    loaded = {name: load_screening_surrogate(path, choice) for name, path in models.items()}
+    surrogates = {name: (model, features) for name, (model, features, _) in loaded.items()}
+    methods = {name: method for name, (_, _, method) in loaded.items()}
     experiment = load_experiment(experiment_file)
     result = calibrate(surrogates, experiment, screening, constants)
     write_valid_sets(result, Path(files.table5).parent)
@@ -108,7 +129,7 @@ def identify(
     text = statement + (
         f"# Table 5: valid parameter sets for {experiment.material}\n\n"
         f"{result.n_total} candidate sets screened in {result.elapsed_s:.2f} s; tolerance "
-        f"{screening['tolerance']:.0%}.\n\n"
+        f"{screening['tolerance']:.0%}; {screened_with_statement(methods, choice)}\n\n"
     )
     text += table5_markdown(result.table5) if len(result.table5) else "No measurement to match.\n"
     Path(files.table5).write_text(text + "\n")
@@ -119,6 +140,7 @@ def identify(
         "n_valid": {g: len(v) for g, v in result.valid.items()},
         "n_total": result.n_total,
         "parameters": result.identified,
+        "screened_with": methods,
     }
     if result.at_identified:
         record["predicted_at_mean"] = result.at_identified

@@ -1,5 +1,6 @@
 """Training the surrogate of one bulk value: the hidden-size sweep, the baselines, the
-cross-validation by parameter set and Table 4."""
+cross-validation by parameter set, Table 4 and the Gaussian process that may screen instead of
+the network (``surrogate.screen_with``)."""
 
 import json
 import logging
@@ -13,7 +14,7 @@ import pandas as pd
 
 from demcal.bulk.dataset import PARAMETERS, training_rows
 from demcal.core.provenance import write_sidecar
-from demcal.surrogates.baselines import baseline_predictions
+from demcal.surrogates.baselines import baseline_predictions, gaussian_process_regression
 from demcal.surrogates.cross_validation import (
     METHODS,
     CrossValidation,
@@ -27,10 +28,16 @@ from demcal.surrogates.hidden_size_sweep import SweepResult, sweep_hidden_sizes
 from demcal.surrogates.log_inputs import log_columns
 from demcal.surrogates.metrics import regression_metrics
 from demcal.surrogates.network import MLPSurrogate
+from demcal.surrogates.process_surrogate import ProcessSurrogate
 from demcal.surrogates.table4 import SPLIT_PARTS, method_rows, section_markdown
 from demcal.surrogates.table4 import write_table4_document as write_table4_document
 
 _log = logging.getLogger(__name__)
+
+#: The Gaussian process of a bulk value, written beside its network (``model.pt``).
+PROCESS_FILE = "process.json"
+#: Table 4 method of each ``surrogate.screen_with`` choice.
+SCREENING_METHODS = {"network": "ANN", "process": "Gaussian"}
 
 #: Candidate inputs per bulk value (paper section "Artificial Neural Networks").
 SHEAR_INPUTS = (*PARAMETERS, "normal_stress", "P")
@@ -108,8 +115,10 @@ def train_output(
         The ``surrogate`` config section (``hidden_sizes``, ``split``, ``seed``,
         ``max_epochs``, ``patience``, ``cv_folds``).
     out_dir : path
-        Receives model.pt (+ .json sidecar), sweep.csv, table4.csv/.md, cv_folds.csv (one row
-        per fold and method; only a header without cross-validation) and the figures.
+        Receives model.pt (+ .json sidecar), process.json (the Gaussian process on all usable
+        rows, :class:`demcal.surrogates.process_surrogate.ProcessSurrogate`), sweep.csv,
+        table4.csv/.md, cv_folds.csv (one row per fold and method; only a header without
+        cross-validation) and the figures.
 
     Raises
     ------
@@ -176,6 +185,11 @@ def train_output(
             out_dir / f"parity_{method.lower()}.png",
         )
     r2_vs_hidden_size(sweep.table, out_dir / "r2_vs_hidden_size.png")
+    # The process that may screen (surrogate.screen_with) learns from every usable row.
+    process = gaussian_process_regression(seed, log_inputs=logs).fit(X, y)
+    ProcessSurrogate.from_pipeline(process, features).save(
+        out_dir / PROCESS_FILE, metadata={"output": output, "n_samples": len(rows)}
+    )
     cv_metrics = {}
     if cv is not None:
         ann = table4.loc["ANN"]
@@ -239,3 +253,64 @@ def load_surrogate(path: str | Path) -> tuple[MLPSurrogate, list[str]]:
     if features is None:
         raise ValueError(f"{path}.json: no feature list in the sidecar")
     return model, list(features)
+
+
+def screening_method(table4: pd.DataFrame, choice: str) -> str:
+    """The Table 4 method (``"ANN"`` or ``"Gaussian"``) that screens a bulk value.
+
+    Parameters
+    ----------
+    table4 : DataFrame
+        The bulk value's Table 4 rows (index: method; column ``cv_r2``).
+    choice : {"network", "process", "best"}
+        ``surrogate.screen_with``; ``best`` takes the higher cross-validated R^2 of the two,
+        the network on a tie or without cross-validation.
+
+    Returns
+    -------
+    str
+    """
+    if choice in SCREENING_METHODS:
+        return SCREENING_METHODS[choice]
+    if choice != "best":
+        raise ValueError(f"surrogate.screen_with: {choice!r} is none of network, process, best")
+    ann, gp = (float(table4.loc[m, "cv_r2"]) for m in ("ANN", "Gaussian"))
+    return "Gaussian" if np.isfinite(gp) and (not np.isfinite(ann) or gp > ann) else "ANN"
+
+
+def load_screening_surrogate(
+    model_path: str | Path, choice: str
+) -> tuple[MLPSurrogate | ProcessSurrogate, list[str], str]:
+    """The surrogate that screens one bulk value, from the files of its training.
+
+    Parameters
+    ----------
+    model_path : path
+        The network (``model.pt``); Table 4 (``table4.csv``) and the process
+        (:data:`PROCESS_FILE`) lie beside it.
+    choice : {"network", "process", "best"}
+        ``surrogate.screen_with`` (:func:`screening_method`).
+
+    Returns
+    -------
+    model : MLPSurrogate or ProcessSurrogate
+        Has ``predict_torch``.
+    features : list of str
+        Its ordered input names.
+    method : str
+        ``"ANN"`` or ``"Gaussian"``.
+    """
+    model, features = load_surrogate(model_path)
+    folder = Path(model_path).parent
+    method = "ANN"
+    if choice != "network":
+        method = screening_method(pd.read_csv(folder / "table4.csv", index_col=0), choice)
+    if method == "ANN":
+        return model, features, method
+    process = ProcessSurrogate.load(folder / PROCESS_FILE)
+    if process.features != features:
+        raise ValueError(
+            f"{folder / PROCESS_FILE}: inputs {process.features} differ from the network's "
+            f"{features}"
+        )
+    return process, features, method

@@ -65,6 +65,7 @@ rule sequential_train_surrogate:
     output:
         model=f"{SEQ_ROUND}/surrogates/{{output}}/model.pt",
         table4=f"{SEQ_ROUND}/surrogates/{{output}}/table4.csv",
+        process=f"{SEQ_ROUND}/surrogates/{{output}}/process.json",
     log:
         f"{LOGS}/sequential/round_{{round}}/surrogates/{{output}}.log",
     wildcard_constraints:
@@ -85,6 +86,9 @@ checkpoint sequential_identify:
     input:
         models=lambda wc: [
             round_path(wc.round, f"surrogates/{o}/model.pt") for o in ROUND_OUTPUTS
+        ],
+        processes=lambda wc: [
+            round_path(wc.round, f"surrogates/{o}/process.json") for o in ROUND_OUTPUTS
         ],
         experiment=config["experiment"],
         dataset=f"{SEQ_ROUND}/dataset.csv",

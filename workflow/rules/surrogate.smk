@@ -14,6 +14,7 @@ rule train_surrogate:
     output:
         model=f"{RESULTS}/surrogates/{{output}}/model.pt",
         table4=f"{RESULTS}/surrogates/{{output}}/table4.csv",
+        process=f"{RESULTS}/surrogates/{{output}}/process.json",
         sweep=f"{RESULTS}/surrogates/{{output}}/sweep.csv",
         cv_folds=f"{RESULTS}/surrogates/{{output}}/cv_folds.csv",
         parity_ann=report(

@@ -1,0 +1,229 @@
+"""The Gaussian process of a bulk value as a screening surrogate.
+
+With a few dozen parameter sets the process often cross-validates far better than the networks
+(``docs/identification.md``). For screening millions of candidate sets it needs what a network
+offers: a file, a float32 ``predict_torch`` over chunks and no scikit-learn at screening time.
+:class:`ProcessSurrogate` keeps the posterior mean of a fitted
+:func:`demcal.surrogates.baselines.gaussian_process_regression` pipeline,
+
+    y(x) = y_mean + y_std * sum_i alpha_i * c * exp(-|(x' - x_i) / l|^2 / 2),
+
+where ``x'`` is ``x`` with the logarithm of the log columns, standardised as in training,
+``x_i`` the standardised training inputs, ``alpha`` the process's weights (the white-noise
+term adds nothing between distinct points), ``c`` the signal variance and ``l`` the length
+scales. It is written as JSON: plain numbers, readable anywhere.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+import torch
+from sklearn.pipeline import Pipeline
+
+from demcal.surrogates.log_inputs import take_logs
+
+#: Format tag of the file.
+PROCESS_FORMAT = "demcal-gaussian-process-1"
+
+
+class ProcessSurrogate:
+    """Posterior mean of a fitted Gaussian process over named SI inputs.
+
+    Parameters
+    ----------
+    features : sequence of str
+        Ordered input names.
+    log_inputs : sequence of int
+        Columns taken as their natural logarithm before standardising.
+    x_mean, x_scale : array_like, shape (d,)
+        Standardisation of the (log-taken) inputs.
+    x_train : array_like, shape (n, d)
+        Standardised training inputs.
+    alpha : array_like, shape (n,)
+        Weights of the training points (normalised target units).
+    length_scales : array_like, shape (d,)
+        RBF length scales in standardised input units.
+    signal_variance : float
+        Constant factor ``c`` of the kernel.
+    y_mean, y_std : float
+        Target normalisation, units of the bulk value.
+    """
+
+    def __init__(
+        self,
+        features: Sequence[str],
+        log_inputs: Sequence[int],
+        x_mean: npt.ArrayLike,
+        x_scale: npt.ArrayLike,
+        x_train: npt.ArrayLike,
+        alpha: npt.ArrayLike,
+        length_scales: npt.ArrayLike,
+        signal_variance: float,
+        y_mean: float,
+        y_std: float,
+    ) -> None:
+        self.features = [str(f) for f in features]
+        self.log_inputs = tuple(int(c) for c in log_inputs)
+        self.x_mean = np.asarray(x_mean, dtype=np.float64)
+        self.x_scale = np.asarray(x_scale, dtype=np.float64)
+        self.x_train = np.asarray(x_train, dtype=np.float64)
+        self.alpha = np.asarray(alpha, dtype=np.float64).reshape(-1)
+        self.length_scales = np.broadcast_to(
+            np.asarray(length_scales, dtype=np.float64), self.x_mean.shape
+        ).copy()
+        self.signal_variance = float(signal_variance)
+        self.y_mean = float(y_mean)
+        self.y_std = float(y_std)
+        d = len(self.features)
+        n = self.alpha.shape[0]
+        if self.x_train.shape != (n, d) or self.x_mean.shape != (d,) or self.x_scale.shape != (d,):
+            raise ValueError(
+                f"inconsistent process: {d} features, x_train {self.x_train.shape}, "
+                f"alpha ({n},), x_mean {self.x_mean.shape}, x_scale {self.x_scale.shape}"
+            )
+
+    @classmethod
+    def from_pipeline(cls, pipeline: Pipeline, features: Sequence[str]) -> ProcessSurrogate:
+        """Extract the posterior mean of a fitted `gaussian_process_regression` pipeline.
+
+        Parameters
+        ----------
+        pipeline : sklearn.pipeline.Pipeline
+            Fitted, steps ``log``, ``scale`` and ``regressor``.
+        features : sequence of str
+            Its ordered input names.
+        """
+        log_step = pipeline.named_steps["log"]
+        scaler = pipeline.named_steps["scale"]
+        gp = pipeline.named_steps["regressor"].gp_
+        kernel = gp.kernel_
+        return cls(
+            features=features,
+            log_inputs=(log_step.kw_args or {}).get("columns", ()),
+            x_mean=scaler.mean_,
+            x_scale=scaler.scale_,
+            x_train=gp.X_train_,
+            alpha=gp.alpha_,
+            length_scales=kernel.k1.k2.length_scale,
+            signal_variance=kernel.k1.k1.constant_value,
+            y_mean=float(np.atleast_1d(gp._y_train_mean)[0]),
+            y_std=float(np.atleast_1d(gp._y_train_std)[0]),
+        )
+
+    def _standardised(self, X: np.ndarray) -> np.ndarray:
+        return (take_logs(X, self.log_inputs) - self.x_mean) / self.x_scale
+
+    def predict(self, X: npt.ArrayLike) -> np.ndarray:
+        """Posterior mean, float64.
+
+        Parameters
+        ----------
+        X : array_like, shape (n, d)
+            Inputs in SI units, in the order of `features`.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            Units of the bulk value.
+        """
+        xs = self._standardised(np.asarray(X, dtype=np.float64)) / self.length_scales
+        xt = self.x_train / self.length_scales
+        sq = (xs**2).sum(1)[:, None] + (xt**2).sum(1)[None, :] - 2.0 * xs @ xt.T
+        k = self.signal_variance * np.exp(-0.5 * np.maximum(sq, 0.0))
+        return self.y_mean + self.y_std * (k @ self.alpha)
+
+    def predict_torch(self, X: torch.Tensor, chunk_size: int = 32_768) -> torch.Tensor:
+        """Posterior mean of many rows in float32, for screening candidate grids.
+
+        Parameters
+        ----------
+        X : torch.Tensor, shape (n, d)
+            Inputs in SI units (log columns as they are); not modified.
+        chunk_size : int, default 32768
+            Rows per chunk; bounds the kernel buffer to chunk_size x n_train floats.
+
+        Returns
+        -------
+        torch.Tensor of float32, shape (n,)
+        """
+        if X.ndim != 2 or X.shape[1] != len(self.features):
+            raise ValueError(f"X must have shape (n, {len(self.features)}), got {tuple(X.shape)}")
+        # float64 inside: the weights of a nearly noise-free process are large and of both
+        # signs, so float32 kernels lose digits in the sum.
+        f64 = torch.float64
+        scale = self.x_scale * self.length_scales
+        shift = torch.from_numpy(self.x_mean / scale)
+        inv = torch.from_numpy(1.0 / scale)
+        xt = torch.from_numpy(self.x_train / self.length_scales)
+        xt_sq = (xt**2).sum(1)
+        weights = torch.from_numpy(self.signal_variance * self.y_std * self.alpha)
+        logs = list(self.log_inputs)
+        out = torch.empty(X.shape[0], dtype=torch.float32)
+        with torch.no_grad():
+            for start in range(0, X.shape[0], chunk_size):
+                # A copy: the caller's grid keeps its SI values.
+                chunk = X[start : start + chunk_size].to(f64, copy=True)
+                if logs:
+                    chunk[:, logs] = chunk[:, logs].log()
+                xs = chunk * inv - shift
+                sq = (xs**2).sum(1, keepdim=True) + xt_sq - 2.0 * xs @ xt.T
+                k = torch.exp(-0.5 * sq.clamp_min_(0.0))
+                out[start : start + chunk_size] = (k @ weights + self.y_mean).to(torch.float32)
+        return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable description (every number as a Python float)."""
+        return {
+            "format": PROCESS_FORMAT,
+            "features": self.features,
+            "log_inputs": list(self.log_inputs),
+            "x_mean": self.x_mean.tolist(),
+            "x_scale": self.x_scale.tolist(),
+            "x_train": self.x_train.tolist(),
+            "alpha": self.alpha.tolist(),
+            "length_scales": self.length_scales.tolist(),
+            "signal_variance": self.signal_variance,
+            "y_mean": self.y_mean,
+            "y_std": self.y_std,
+        }
+
+    def save(self, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
+        """Write the process as JSON (``metadata`` under its own key)."""
+        path = Path(path)
+        path.write_text(json.dumps({**self.to_dict(), "metadata": metadata or {}}) + "\n")
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> ProcessSurrogate:
+        """Read a process written by `save`.
+
+        Raises
+        ------
+        ValueError
+            If the file is not a process of this format or its arrays disagree in shape.
+        """
+        data = json.loads(Path(path).read_text())
+        if data.get("format") != PROCESS_FORMAT:
+            raise ValueError(
+                f"{path}: not a Gaussian-process file of format {PROCESS_FORMAT} "
+                f"(format {data.get('format')!r})"
+            )
+        keys = (
+            "features",
+            "log_inputs",
+            "x_mean",
+            "x_scale",
+            "x_train",
+            "alpha",
+            "length_scales",
+            "signal_variance",
+            "y_mean",
+            "y_std",
+        )
+        return cls(**{k: data[k] for k in keys})
