@@ -25,11 +25,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from demcal.bulk.dataset import OUTPUTS
 from demcal.core.config import load_config
 from demcal.surrogates.training import TEST_OF, train_output
 
-_ALL = tuple(o for outs in OUTPUTS.values() for o in outs)
+_ALL = tuple(TEST_OF)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -111,7 +111,7 @@ def identify(
     CalibrationResult
         Valid sets per group, Table 5 and the identified set.
     """
-    choice = str(config.get("surrogate", {}).get("screen_with", "network"))
+    choice = str(config["surrogate"]["screen_with"])
     loaded = {name: load_screening_surrogate(path, choice) for name, path in models.items()}
     surrogates = {name: (model, features) for name, (model, features, _) in loaded.items()}
     methods = {name: method for name, (_, _, method) in loaded.items()}

@@ -285,10 +285,9 @@ class MLPSurrogate(RegressorMixin, BaseEstimator):
         out = torch.empty(X.shape[0], dtype=torch.float32, device=X.device)
         with torch.no_grad():
             for start in range(0, X.shape[0], chunk_size):
-                chunk = X[start : start + chunk_size].to(torch.float32)
+                # With log columns a copy: the caller's grid must keep its SI values.
+                chunk = X[start : start + chunk_size].to(torch.float32, copy=bool(logs))
                 if logs:
-                    # A copy: the caller's grid must keep its SI values.
-                    chunk = chunk.clone()
                     chunk[:, logs] = chunk[:, logs].log()
                 hidden = torch.addmm(b1_t, chunk, W1_t).tanh_()
                 torch.mv(hidden, w2_t, out=out[start : start + chunk_size])
