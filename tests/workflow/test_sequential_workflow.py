@@ -3,6 +3,7 @@ decision, the report, the reuse of the last round in the usual stages, and a res
 runs no DEM case twice."""
 
 import json
+import shutil
 from pathlib import Path
 
 import pandas as pd
@@ -170,3 +171,25 @@ def test_resumed_study_reruns_nothing(study):
     again = snakemake(work, "-n", "--", *TARGETS)
     assert again.returncode == 0
     assert "Nothing to be done" in again.stdout + again.stderr
+
+
+def test_study_interrupted_after_a_later_identification_resumes(study, tmp_path):
+    """Stopped after round 1's identification and verification runs, before its record: the
+    resumed study writes the same record and table from the finished runs and runs no DEM case
+    again (Snakemake registers a finished checkpoint only for jobs of its first pass over the
+    DAG, so round 1's verification runs were a placeholder here before)."""
+    work, _, _ = study
+    copy = tmp_path / "resumed"
+    shutil.copytree(work, copy, symlinks=True)
+    seq = copy / "results" / "sequential"
+    record, table = seq / "round_1" / "state.json", seq / "rounds.csv"
+    before = record.read_text(), table.read_text()
+    runs = {p: p.stat().st_mtime_ns for p in (copy / "results").rglob("status.json")}
+    assert len(runs) > 0
+    for path in (record, seq / "round_1" / "verification.md", *seq.glob("rounds.*")):
+        path.unlink()
+    res = snakemake(copy, "--", "results/sequential/rounds.md")
+    assert res.returncode == 0, res.stderr[-6000:]
+    assert (record.read_text(), table.read_text()) == before
+    for path, stamp in runs.items():
+        assert path.stat().st_mtime_ns == stamp, path

@@ -110,7 +110,12 @@ def round_verification_bulk(round_no):
     """bulk.csv of round ``round_no``'s verification runs; none when it identified nothing."""
     if round_no < 0:
         return []
-    identified = checkpoints.sequential_identify.get(round=round_no).output.identified
+    identified = Path(round_path(round_no, "identification/identified_parameters.json"))
+    # A resumed study: Snakemake registers a finished checkpoint only for jobs it met in its
+    # first pass over the DAG, so a later round's identification, finished before the run,
+    # would stay a placeholder here. An identify job that reruns updates its dependants anyway.
+    if not identified.is_file():
+        identified = checkpoints.sequential_identify.get(round=round_no).output.identified
     if not json.loads(Path(identified).read_text()).get("parameters"):
         return []
     return verification_bulk_under(round_path(round_no, "verification"))
