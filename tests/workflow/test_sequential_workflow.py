@@ -177,7 +177,7 @@ def test_study_interrupted_after_a_later_identification_resumes(study, tmp_path)
     """Stopped after round 1's identification and verification runs, before its record: the
     resumed study writes the same record and table from the finished runs and runs no DEM case
     again (Snakemake registers a finished checkpoint only for jobs of its first pass over the
-    DAG, so round 1's verification runs were a placeholder here before)."""
+    DAG, and round 1's identification is not among them here)."""
     work, _, _ = study
     copy = tmp_path / "resumed"
     shutil.copytree(work, copy, symlinks=True)
