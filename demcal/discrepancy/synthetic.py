@@ -61,8 +61,8 @@ _PROFILES: dict[str, dict[str, Any]] = {
     # Three stresses show how an effect changes with stress (cohesion's share of the strength
     # falls as 1 / sigma, rolling resistance's does not); one shear load (P = 0.5) gives one
     # run per stress with all three shear-cell observables. Not below 1 068 Pa: at 500 Pa the
-    # soft particles' own cohesive overlap reaches 10-30 % of the radius at the catalogue's
-    # cohesion and the cell reads nonsense (docs/discrepancy.md). The particle density is
+    # soft particles' own cohesive overlap reaches 9-25 % of the radius at drawn cohesions of
+    # 2.8-4.8e4 J/m^3 and the cell reads nonsense (docs/discrepancy.md). The particle density is
     # taken as measured (pycnometer), so that a few cases give trustworthy surrogates; up to
     # 0.9: the soft tiny cell turns unstable near coefficientFriction 1.
     "tiny": {
