@@ -221,8 +221,15 @@ def test_cohesion_signature_weakens_with_stress(studies):
         # Cohesion loosens a packing (the packing fraction of spheres falls as the cohesive
         # force grows against the weight, Yang, Zou & Yu 2000), raises the friction values,
         # and its extra shear strength is a larger share of the stress at low normal stress.
-        # Single probe runs scatter (mu_sh by about 0.1), so mu_sh is not asserted.
+        # Single probe runs scatter (mu_psh by 0.03-0.05, mu_sh by about 0.1), so mu_sh is not
+        # asserted and neither is the sign of the small response at the higher stresses.
         assert "rho_b -" in signature, (name, signature)
-        rise = re.search(r"mu_psh \+([\d.]+) at 1 068 Pa, \+([\d.]+) at 2 029 Pa", signature)
-        assert rise is not None, (name, signature)
-        assert float(rise.group(1)) > float(rise.group(2)) > 0.0, (name, signature)
+        psh = re.search(r"mu_psh ([^;(]*)", signature)
+        assert psh is not None, (name, signature)
+        rise = {
+            float(stress.replace(" ", "")): float(value)
+            for value, stress in re.findall(r"([+-][\d.]+) at ([\d ]+) Pa", psh.group(1))
+        }
+        assert sorted(rise) == [1068.0, 2029.0, 4000.0], (name, signature)
+        assert rise[1068.0] > 0.1, (name, signature)
+        assert rise[1068.0] > max(rise[2029.0], rise[4000.0]), (name, signature)
