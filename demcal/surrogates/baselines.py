@@ -101,6 +101,10 @@ class AnisotropicGaussianProcess(RegressorMixin, BaseEstimator):
         Kernel with optimised hyper-parameters.
     length_scales_ : numpy.ndarray, shape (n_features_in_,)
         Optimised RBF length scales.
+    noise_variance_ : float
+        Variance of the white-noise term in units of y squared: the scatter of a training
+        target about the process's mean, i.e. the seed-to-seed scatter of the DEM runs plus
+        whatever the kernel cannot follow.
     """
 
     def __init__(
@@ -156,6 +160,9 @@ class AnisotropicGaussianProcess(RegressorMixin, BaseEstimator):
             self.gp_ = gp.fit(X_arr, y_arr)
         self.kernel_ = self.gp_.kernel_
         self.length_scales_ = np.atleast_1d(self.kernel_.k1.k2.length_scale).astype(np.float64)
+        # The kernel works on targets divided by their standard deviation (normalize_y).
+        y_std = float(np.atleast_1d(self.gp_._y_train_std)[0])
+        self.noise_variance_ = float(self.kernel_.k2.noise_level) * y_std**2
         return self
 
     def predict(

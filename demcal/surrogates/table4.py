@@ -3,10 +3,11 @@
 Per bulk value, :func:`method_rows` gives one row per regression method with the sizes of the
 single split (parameter sets and rows in training, generalisation and test), the test-set
 metrics of the paper, the cross-validated R^2 and RMSE by parameter set with their spread over
-the folds, and the data mean. :func:`write_table4_document` gathers the rows of every bulk
-value into ``table4.md`` and ``table4.csv`` and adds the acceptance tolerance of the screening
-(``screening.tolerance`` times the measured value, or times the data mean for a value that was
-not measured) and whether the RMSE lies below it.
+the folds, the data mean, and the ceiling of R^2 set by the scatter of single runs (the white
+noise of the Gaussian process on all rows). :func:`write_table4_document` gathers the rows of
+every bulk value into ``table4.md`` and ``table4.csv`` and adds the acceptance tolerance of the
+screening (``screening.tolerance`` times the measured value, or times the data mean for a value
+that was not measured) and whether the RMSE lies below it.
 """
 
 from __future__ import annotations
@@ -62,6 +63,8 @@ def method_rows(
     cv_note: str,
     y_mean: float,
     hidden_size: int,
+    noise_sd: float = float("nan"),
+    y_var: float = float("nan"),
 ) -> pd.DataFrame:
     """The Table 4 rows of one bulk value, one per method (the per-value ``table4.csv``).
 
@@ -81,6 +84,12 @@ def method_rows(
         Mean of the bulk value over all usable rows, units of y.
     hidden_size : int
         Hidden neurons of the network (given on the ANN row only).
+    noise_sd : float, optional
+        Scatter of one row about the mean response, units of y: the white-noise term of the
+        Gaussian process fitted on all rows. NaN when unknown.
+    y_var : float, optional
+        Variance of the bulk value over all usable rows (the denominator of R^2), units of y
+        squared.
 
     Returns
     -------
@@ -88,7 +97,9 @@ def method_rows(
         Index ``method`` in the order of ``test_metrics``; columns ``output``, ``n_sets``,
         ``n_rows``, ``<part>_sets`` and ``<part>_rows`` for each of `SPLIT_PARTS`, ``test_r2``,
         ``test_rmse``, ``test_mae``, ``test_mse``, the `CV_COLUMNS` (``cv_folds`` 0 and NaN
-        scores without cross-validation), ``cv_note``, ``y_mean`` and ``hidden_size``.
+        scores without cross-validation), ``cv_note``, ``y_mean``, ``hidden_size``,
+        ``noise_sd`` and ``r2_ceiling`` = 1 - noise_sd^2 / y_var, the R^2 that even the exact
+        mean response would score on these rows (the same on every method's row).
     """
     summary = cv.summary() if cv is not None else None
     rows = []
@@ -107,6 +118,8 @@ def method_rows(
         row["cv_note"] = cv_note
         row["y_mean"] = float(y_mean)
         row["hidden_size"] = int(hidden_size) if method == "ANN" else pd.NA
+        row["noise_sd"] = float(noise_sd)
+        row["r2_ceiling"] = 1.0 - float(noise_sd) ** 2 / float(y_var)
         rows.append(row)
     table = pd.DataFrame(rows).set_index("method")
     return table.astype({"cv_folds": int, "cv_sets": int, "cv_rows": int})
@@ -292,6 +305,15 @@ def section_markdown(name: str, table: pd.DataFrame, sweep: pd.DataFrame | None 
             "hidden neurons (also in every fold); the paper's rule (best test R^2) would pick "
             f"{select_by_test_r2(sweep)}."
         )
+    ceiling = float(first.get("r2_ceiling", np.nan))
+    if np.isfinite(ceiling):
+        text.append(
+            f"Scatter of one row about the mean response (white-noise term of the Gaussian "
+            f"process on all rows): {_g(first['noise_sd'])}, so even the exact mean response "
+            f"would score an R^2 of at most {_g(ceiling)} on these rows; more parameter sets "
+            "bring the CV R^2 towards that ceiling, only replicate runs (design.replicates) "
+            "raise it."
+        )
     if "tolerance_abs" in table:
         basis = (
             "the measured value (the smallest, if measured at several conditions)"
@@ -322,7 +344,9 @@ predicted by models trained without its set, and R^2 and RMSE are computed once 
 predictions (the range over the folds beside them). "tolerance" is the absolute acceptance
 tolerance of the screening, screening.tolerance times the measured value; "RMSE < tol" says
 whether the surrogate's typical error is smaller than it, i.e. whether the surrogate can
-resolve the acceptance band it screens with. Units are those of the bulk value.
+resolve the acceptance band it screens with. Each section also gives the scatter of one row
+about the mean response and the R^2 ceiling it sets, 1 - scatter^2 / variance of the rows: the
+score of a perfect surrogate on these rows. Units are those of the bulk value.
 """
 
 

@@ -69,6 +69,18 @@ def test_gaussian_process_learns_which_input_matters() -> None:
     assert scales[2] > 10.0 * max(scales[0], scales[1])
 
 
+@pytest.mark.parametrize("sd", [0.02, 0.1])
+def test_gaussian_process_estimates_the_scatter_of_the_targets(sd: float) -> None:
+    # The white-noise term must come back in units of y: the seed scatter Table 4's R^2
+    # ceiling is computed from. Targets scaled by 100 check that normalize_y is undone.
+    rng = np.random.default_rng(11)
+    X, y = _nonlinear_data(200, seed=6)
+    y = 100.0 * (y + sd * rng.normal(size=y.size))
+    gp = gaussian_process_regression(seed=0, n_restarts_optimizer=1).fit(X, y)
+    noise_sd = np.sqrt(gp.named_steps["regressor"].noise_variance_)
+    assert noise_sd == pytest.approx(100.0 * sd, rel=0.2)
+
+
 def test_gaussian_process_is_seeded_and_reports_std() -> None:
     X, y = _nonlinear_data(60, seed=5)
     a = gaussian_process_regression(seed=7, n_restarts_optimizer=2).fit(X, y)

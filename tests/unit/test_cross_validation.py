@@ -212,6 +212,13 @@ def test_train_output_writes_split_sizes_and_cross_validation(tmp_path: Path) ->
     assert (row["cv_folds"], row["cv_sets"], row["cv_rows"]) == (4, 14, 56)
     assert row["cv_r2"] > 0.9 and row["cv_r2_min"] <= row["cv_r2"] <= row["cv_r2_max"]
     assert row["hidden_size"] == trained.sweep.selected_size
+    # rho_b scatters by 3 kg/m^3 about its mean response: the process's white noise finds it,
+    # and the ceiling of R^2 follows from it and the rows' variance (the same on every method).
+    assert row["noise_sd"] == pytest.approx(3.0, rel=0.3)
+    rho_rows = data[data["test"] == "shear_cell"]["rho_b"]
+    ceiling = 1.0 - row["noise_sd"] ** 2 / np.var(rho_rows)
+    assert table["r2_ceiling"].to_numpy() == pytest.approx(np.full(3, ceiling), rel=1e-6)
+    assert row["cv_r2"] <= row["r2_ceiling"] + 0.01
     folds = pd.read_csv(tmp_path / "rho_b" / "cv_folds.csv")
     assert len(folds) == 4 * 3 and folds.groupby("method")["test_sets"].sum().eq(14).all()
     meta = json.loads((tmp_path / "rho_b" / "model.pt.json").read_text())["metadata"]
@@ -257,6 +264,7 @@ def test_train_output_writes_split_sizes_and_cross_validation(tmp_path: Path) ->
     text = md.read_text()
     assert "CV folds (sets/rows)" in text and "| ANN | 10/2/2 | 40/8/8 |" in text
     assert "4 (14/56)" in text and "Cross-validation: off." in text
+    assert f"would score an R^2 of at most {rho['r2_ceiling']:.3g}" in text
     # The last table of every section keeps the paper's layout (metrics by method).
     for section in text.split("\n## ")[1:]:
         last = section.strip().splitlines()[-6:]
