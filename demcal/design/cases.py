@@ -4,8 +4,9 @@ A shear-cell case is a design row at one pre-shear normal stress and, by default
 load P (``c0003_s2_p1``); with ``shear_cell.separate_runs: false`` all P values run as cycles
 in one deck (``c0003_s2``). An angle-of-repose case is a design row (``c0003``). With
 ``design.replicates`` = k > 1 every case also runs as replicates ``c0003_r2_s2_p1`` ...
-``c0003_r<k>_s2_p1`` (``c0003_r2`` ... for the angle of repose), each from its own packing.
-Wildcards carry these ids, never floats.
+``c0003_r<k>_s2_p1`` (``c0003_r2`` ... for the angle of repose), each from its own packing;
+``design.repose_replicates`` sets the heaps' count apart. Wildcards carry these ids, never
+floats.
 """
 
 import re
@@ -33,9 +34,18 @@ _KEYS_BY_KIND = {
 }
 
 
-def design_replicates(config: Mapping[str, Any]) -> int:
-    """DEM runs of every design case (``design.replicates``, 1 when absent)."""
-    return int(config["design"].get("replicates", 1))
+def design_replicates(config: Mapping[str, Any], test: str = "shear_cell") -> int:
+    """DEM runs of every design case of ``test``.
+
+    ``design.replicates`` (1 when absent); for the angle of repose ``design.repose_replicates``
+    where given, since a heap costs a small fraction of a shear-cell set.
+    """
+    section = config["design"]
+    shared = int(section.get("replicates", 1))
+    heaps = section.get("repose_replicates")
+    if test == "angle_of_repose" and heaps is not None:
+        return int(heaps)
+    return shared
 
 
 def replicate_bases(run: str, count: int) -> list[str]:
@@ -48,7 +58,7 @@ def with_replicates(
 ) -> list[str]:
     """Case ids of design rows ``bases`` with load ``suffixes`` (none: the angle of repose),
     each case followed by its replicate runs (``c0003_r2_s1_p1`` ...)."""
-    k = design_replicates(config)
+    k = design_replicates(config, "shear_cell" if suffixes else "angle_of_repose")
     return [
         f"{replicate}{suffix}"
         for base in bases

@@ -63,13 +63,18 @@ def screened_with_statement(methods: Mapping[str, str], choice: str) -> str:
     Parameters
     ----------
     methods : mapping
-        Bulk value -> Table 4 method (``"ANN"`` or ``"Gaussian"``).
+        Bulk value -> Table 4 method (``"ANN"``, ``"Gaussian"`` or ``"Bayesian"``).
     choice : str
         ``surrogate.screen_with``.
     """
-    names = {"ANN": "network", "Gaussian": "Gaussian process"}
+    names = {"ANN": "network", "Gaussian": "Gaussian process", "Bayesian": "linear regression"}
     parts = ", ".join(f"{value} by its {names[m]}" for value, m in methods.items())
-    rule = " (higher cross-validated R^2)" if choice == "best" else ""
+    rule = (
+        " (highest cross-validated R^2; the linear regression only where its CV RMSE is below"
+        " the tolerance)"
+        if choice == "best"
+        else ""
+    )
     return f"screened {parts}{rule}."
 
 
@@ -112,13 +117,16 @@ def identify(
         Valid sets per group, Table 5 and the identified set.
     """
     choice = str(config["surrogate"]["screen_with"])
-    loaded = {name: load_screening_surrogate(path, choice) for name, path in models.items()}
+    experiment = load_experiment(experiment_file)
+    tol = float(screening["tolerance"])
+    loaded = {
+        name: load_screening_surrogate(path, choice, experiment, tol)
+        for name, path in models.items()
+    }
     surrogates = {name: (model, features) for name, (model, features, _) in loaded.items()}
     methods = {name: method for name, (_, _, method) in loaded.items()}
-    experiment = load_experiment(experiment_file)
     result = calibrate(surrogates, experiment, screening, constants)
     write_valid_sets(result, Path(files.table5).parent)
-    tol = float(screening["tolerance"])
     reach = None
     if dataset is not None:
         reach = reach_of_measurements(pd.read_csv(dataset), experiment, tol)

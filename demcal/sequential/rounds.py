@@ -101,8 +101,10 @@ def decks_per_set(config: Mapping[str, Any]) -> int:
 
 
 def runs_per_set(config: Mapping[str, Any]) -> int:
-    """DEM runs of one parameter set: each of its decks ``design.replicates`` times."""
-    return decks_per_set(config) * design_replicates(config)
+    """DEM runs of one parameter set: each shear-cell deck ``design.replicates`` times, the
+    heap ``design.repose_replicates`` times."""
+    shear = len(shear_suffixes(config)) * design_replicates(config)
+    return shear + design_replicates(config, "angle_of_repose")
 
 
 def verification_runs(config: Mapping[str, Any]) -> int:

@@ -1,6 +1,6 @@
 """Training the surrogate of one bulk value: the hidden-size sweep, the baselines, the
-cross-validation by parameter set, Table 4 and the Gaussian process that may screen instead of
-the network (``surrogate.screen_with``)."""
+cross-validation by parameter set, Table 4 and the Gaussian process and linear regression that
+may screen instead of the network (``surrogate.screen_with``)."""
 
 import json
 import logging
@@ -13,8 +13,13 @@ import numpy as np
 import pandas as pd
 
 from demcal.bulk.dataset import PARAMETERS, training_rows
+from demcal.core.experiments import Experiment
 from demcal.core.provenance import write_sidecar
-from demcal.surrogates.baselines import baseline_predictions, gaussian_process_regression
+from demcal.surrogates.baselines import (
+    baseline_predictions,
+    bayesian_linear_regression,
+    gaussian_process_regression,
+)
 from demcal.surrogates.cross_validation import (
     METHODS,
     CrossValidation,
@@ -25,19 +30,32 @@ from demcal.surrogates.cross_validation import (
 from demcal.surrogates.data_split import split_groups
 from demcal.surrogates.figures import parity_plot, r2_vs_hidden_size
 from demcal.surrogates.hidden_size_sweep import SweepResult, sweep_hidden_sizes
+from demcal.surrogates.linear_surrogate import LinearSurrogate
 from demcal.surrogates.log_inputs import log_columns
 from demcal.surrogates.metrics import regression_metrics
 from demcal.surrogates.network import MLPSurrogate
 from demcal.surrogates.process_surrogate import ProcessSurrogate
-from demcal.surrogates.table4 import SPLIT_PARTS, method_rows, section_markdown
+from demcal.surrogates.table4 import (
+    SPLIT_PARTS,
+    acceptance_reference,
+    method_rows,
+    section_markdown,
+)
 from demcal.surrogates.table4 import write_table4_document as write_table4_document
 
 _log = logging.getLogger(__name__)
 
 #: The Gaussian process of a bulk value, written beside its network (``model.pt``).
 PROCESS_FILE = "process.json"
-#: Table 4 method of each ``surrogate.screen_with`` choice.
-SCREENING_METHODS = {"network": "ANN", "process": "Gaussian"}
+#: The linear regression of a bulk value, beside its network.
+LINEAR_FILE = "linear.json"
+#: Table 4 method of each ``surrogate.screen_with`` choice; ``best`` picks among them in this
+#: order of preference on a tie.
+SCREENING_METHODS = {"network": "ANN", "process": "Gaussian", "linear": "Bayesian"}
+#: Methods that ``best`` takes only where their CV RMSE is below the acceptance tolerance: a
+#: plane imposes straight lines on the whole box, and where it misses by more than the band it
+#: screens with, its slopes (spurious ones included) decide which sets pass.
+RESTRICTED_METHODS = ("Bayesian",)
 
 #: Candidate inputs per bulk value (paper section "Artificial Neural Networks").
 SHEAR_INPUTS = (*PARAMETERS, "normal_stress", "P")
@@ -200,6 +218,10 @@ def train_output(
     ProcessSurrogate.from_pipeline(process, features).save(
         out_dir / PROCESS_FILE, metadata={"output": output, "n_samples": len(rows)}
     )
+    plane = bayesian_linear_regression(logs).fit(X, y)
+    LinearSurrogate.from_pipeline(plane, features).save(
+        out_dir / LINEAR_FILE, metadata={"output": output, "n_samples": len(rows)}
+    )
     cv_metrics = {}
     if cv is not None:
         ann = table4.loc["ANN"]
@@ -265,16 +287,23 @@ def load_surrogate(path: str | Path) -> tuple[MLPSurrogate, list[str]]:
     return model, list(features)
 
 
-def screening_method(table4: pd.DataFrame, choice: str) -> str:
-    """The Table 4 method (``"ANN"`` or ``"Gaussian"``) that screens a bulk value.
+def screening_method(table4: pd.DataFrame, choice: str, tolerance: float | None = None) -> str:
+    """The Table 4 method (``"ANN"``, ``"Gaussian"`` or ``"Bayesian"``) that screens a bulk
+    value.
 
     Parameters
     ----------
     table4 : DataFrame
-        The bulk value's Table 4 rows (index: method; column ``cv_r2``).
-    choice : {"network", "process", "best"}
-        ``surrogate.screen_with``; ``best`` takes the higher cross-validated R^2 of the two,
-        the network on a tie or without cross-validation.
+        The bulk value's Table 4 rows (index: method; columns ``cv_r2``, ``cv_rmse``).
+    choice : {"network", "process", "linear", "best"}
+        ``surrogate.screen_with``; ``best`` takes the highest cross-validated R^2 of the
+        network, the process and, where its CV RMSE is below ``tolerance``, the linear
+        regression (:data:`RESTRICTED_METHODS`); the earlier of :data:`SCREENING_METHODS` on a
+        tie and the network without cross-validation.
+    tolerance : float, optional
+        The acceptance band of the screening in units of the bulk value
+        (``screening.tolerance`` times the measured value); without it ``best`` leaves the
+        linear regression out.
 
     Returns
     -------
@@ -283,44 +312,71 @@ def screening_method(table4: pd.DataFrame, choice: str) -> str:
     if choice in SCREENING_METHODS:
         return SCREENING_METHODS[choice]
     if choice != "best":
-        raise ValueError(f"surrogate.screen_with: {choice!r} is none of network, process, best")
-    ann, gp = (float(table4.loc[m, "cv_r2"]) for m in ("ANN", "Gaussian"))
-    return "Gaussian" if np.isfinite(gp) and (not np.isfinite(ann) or gp > ann) else "ANN"
+        names = ", ".join([*SCREENING_METHODS, "best"])
+        raise ValueError(f"surrogate.screen_with: {choice!r} is none of {names}")
+    best, best_r2 = "ANN", -np.inf
+    for method in SCREENING_METHODS.values():
+        if method not in table4.index:
+            continue
+        r2, rmse = (float(table4.loc[method, k]) for k in ("cv_r2", "cv_rmse"))
+        if method in RESTRICTED_METHODS and not (tolerance is not None and rmse < tolerance):
+            continue
+        if np.isfinite(r2) and r2 > best_r2:
+            best, best_r2 = method, r2
+    return best
 
 
 def load_screening_surrogate(
-    model_path: str | Path, choice: str
-) -> tuple[MLPSurrogate | ProcessSurrogate, list[str], str]:
+    model_path: str | Path,
+    choice: str,
+    experiment: Experiment | None = None,
+    tolerance: float | None = None,
+) -> tuple[MLPSurrogate | ProcessSurrogate | LinearSurrogate, list[str], str]:
     """The surrogate that screens one bulk value, from the files of its training.
 
     Parameters
     ----------
     model_path : path
-        The network (``model.pt``); Table 4 (``table4.csv``) and the process
-        (:data:`PROCESS_FILE`) lie beside it.
-    choice : {"network", "process", "best"}
+        The network (``model.pt``); Table 4 (``table4.csv``), the process
+        (:data:`PROCESS_FILE`) and the linear regression (:data:`LINEAR_FILE`) lie beside it.
+    choice : {"network", "process", "linear", "best"}
         ``surrogate.screen_with`` (:func:`screening_method`).
+    experiment : Experiment, optional
+        The measurements the grid is screened against, and
+    tolerance : float, optional
+        ``screening.tolerance`` (relative): with both, ``best`` may take the linear regression
+        where its CV RMSE is below the acceptance band (the tolerance times the measured
+        value, or times the data mean for a value that is not measured; Table 4's
+        ``tolerance_abs``).
 
     Returns
     -------
-    model : MLPSurrogate or ProcessSurrogate
+    model : MLPSurrogate, ProcessSurrogate or LinearSurrogate
         Has ``predict_torch``.
     features : list of str
         Its ordered input names.
     method : str
-        ``"ANN"`` or ``"Gaussian"``.
+        ``"ANN"``, ``"Gaussian"`` or ``"Bayesian"``.
     """
     model, features = load_surrogate(model_path)
     folder = Path(model_path).parent
     method = "ANN"
     if choice != "network":
-        method = screening_method(pd.read_csv(folder / "table4.csv", index_col=0), choice)
+        table4 = pd.read_csv(folder / "table4.csv", index_col=0)
+        band = None
+        if tolerance is not None:
+            y_mean = float(table4["y_mean"].iloc[0])
+            band = (
+                tolerance
+                * acceptance_reference(str(table4["output"].iloc[0]), experiment, y_mean)[0]
+            )
+        method = screening_method(table4, choice, band)
     if method == "ANN":
         return model, features, method
-    process = ProcessSurrogate.load(folder / PROCESS_FILE)
-    if process.features != features:
-        raise ValueError(
-            f"{folder / PROCESS_FILE}: inputs {process.features} differ from the network's "
-            f"{features}"
-        )
-    return process, features, method
+    if method == "Gaussian":
+        path, other = folder / PROCESS_FILE, ProcessSurrogate.load(folder / PROCESS_FILE)
+    else:
+        path, other = folder / LINEAR_FILE, LinearSurrogate.load(folder / LINEAR_FILE)
+    if other.features != features:
+        raise ValueError(f"{path}: inputs {other.features} differ from the network's {features}")
+    return other, features, method

@@ -336,7 +336,8 @@ def test_heap_only_sets_follow_the_shared_sets() -> None:
         assert low <= column.min() and column.max() <= high
         strata = np.floor((column - low) / (high - low) * extra).astype(int)
         assert sorted(strata.tolist()) == list(range(extra)), name
-    assert study_case_ids(quick, design, "angle_of_repose") == case_ids(n + extra)
+    heap_runs = study_case_ids(quick, design, "angle_of_repose")
+    assert heap_runs[::2] == case_ids(n + extra)  # each followed by its second heap
     shear = study_case_ids(quick, design, "shear_cell")
     assert shear == [f"{c}_s{k}" for c in case_ids(n) for k in (1, 2, 3)]
     # A factorial design and a sequential study's rounds choose every set for both tests: the
@@ -351,17 +352,28 @@ def test_heap_only_sets_follow_the_shared_sets() -> None:
 def test_replicates_follow_every_case_from_their_own_packing() -> None:
     root = Path(__file__).resolve().parents[2]
     quick = load_config(root / "config" / "config.yaml")
-    assert quick["design"]["replicates"] == 1
+    # The quick study: one run of every shear deck, two heaps of every set.
+    assert quick["design"]["replicates"] == 1 and quick["design"]["repose_replicates"] == 2
     design = design_from_config(quick)
+    sets = len(design)
     one = {t: study_case_ids(quick, design, t) for t in ("angle_of_repose", "shear_cell")}
-    three = {**quick, "design": {**quick["design"], "replicates": 3}}
+    assert one["angle_of_repose"][:3] == ["c0001", "c0001_r2", "c0002"]
+    assert len(one["angle_of_repose"]) == 2 * sets
+    assert not [c for c in one["shear_cell"] if "_r" in c]
+    # Without repose_replicates the heaps follow design.replicates.
+    shared = {k: v for k, v in quick["design"].items() if k != "repose_replicates"}
+    three = {**quick, "design": {**shared, "replicates": 3}}
     pd.testing.assert_frame_equal(design_from_config(three), design)
     heaps = study_case_ids(three, design, "angle_of_repose")
     assert heaps[:4] == ["c0001", "c0001_r2", "c0001_r3", "c0002"]
-    assert len(heaps) == 3 * len(one["angle_of_repose"])
+    assert len(heaps) == 3 * sets
     shear = study_case_ids(three, design, "shear_cell")
     assert shear[:4] == ["c0001_s1", "c0001_r2_s1", "c0001_r3_s1", "c0001_s2"]
     assert [c for c in shear if "_r" not in c] == one["shear_cell"]
+    # ... and with it the heaps alone.
+    heaps_only = {**quick, "design": {**shared, "replicates": 3, "repose_replicates": 1}}
+    assert study_case_ids(heaps_only, design, "angle_of_repose") == list(design["case_id"])
+    assert study_case_ids(heaps_only, design, "shear_cell") == shear
     assert replicate_of("c0012_r3_s2") == ("c0012_s2", 3)
     assert replicate_of("c0012_s2") == ("c0012_s2", 1)
     assert replicate_of("identified2_s1_p1") == ("identified2_s1_p1", 1)

@@ -1,5 +1,6 @@
-"""The Gaussian process as a screening surrogate (demcal.surrogates.process_surrogate) and the
-choice of the surrogate that screens (surrogate.screen_with)."""
+"""The Gaussian process and the linear regression as screening surrogates
+(demcal.surrogates.process_surrogate, demcal.surrogates.linear_surrogate) and the choice of the
+surrogate that screens (surrogate.screen_with)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,8 @@ import pandas as pd
 import pytest
 import torch
 
-from demcal.surrogates.baselines import gaussian_process_regression
+from demcal.surrogates.baselines import bayesian_linear_regression, gaussian_process_regression
+from demcal.surrogates.linear_surrogate import LinearSurrogate
 from demcal.surrogates.network import MLPSurrogate
 from demcal.surrogates.process_surrogate import ProcessSurrogate
 from demcal.surrogates.training import (
@@ -60,13 +62,56 @@ def test_process_predicts_as_the_fitted_pipeline(tmp_path: Path) -> None:
         process.predict_torch(torch.zeros(3, 5))
 
 
-def test_screen_with_best_takes_the_higher_cross_validated_r2() -> None:
-    table = pd.DataFrame({"cv_r2": [0.5, 0.77, -0.01]}, index=["Bayesian", "Gaussian", "ANN"])
+def test_linear_surrogate_predicts_as_the_fitted_pipeline(tmp_path: Path) -> None:
+    X = _inputs(40, seed=3)
+    # A bulk density that is a plane in ln(mu_s), mu_r, rho_p and sigma, with 10 kg/m^3 scatter.
+    y = 1700.0 - 60.0 * np.log(X[:, 0]) - 150.0 * X[:, 1] + 0.3 * X[:, 2] + 4e-3 * X[:, 3]
+    y += np.random.default_rng(4).normal(0.0, 10.0, len(y))
+    pipeline = bayesian_linear_regression(log_inputs=(0,)).fit(X, y)
+    plane = LinearSurrogate.from_pipeline(pipeline, FEATURES)
+    X_new = _inputs(500, seed=5)
+    expected = pipeline.predict(X_new)
+    np.testing.assert_allclose(plane.predict(X_new), expected, rtol=1e-10)
+    grid = torch.from_numpy(X_new).to(torch.float32)
+    got = plane.predict_torch(grid, chunk_size=64).numpy()
+    # float32 inputs and output: a few 1e-7 of ~2000 kg/m^3
+    np.testing.assert_allclose(got, expected, rtol=2e-6)
+    assert float(grid[0, 0]) == pytest.approx(X_new[0, 0], rel=1e-6)  # the grid is untouched
+    # The slopes are the plane's: -60 per unit ln(mu_s), 0.3 per kg/m^3 of particle density.
+    assert plane.coef[0] == pytest.approx(-60.0, rel=0.15)
+    assert plane.coef[2] == pytest.approx(0.3, rel=0.15)
+    loaded = LinearSurrogate.load(plane.save(tmp_path / "linear.json", {"output": "rho_b"}))
+    np.testing.assert_allclose(loaded.predict(X_new), expected, rtol=1e-10)
+    assert json.loads((tmp_path / "linear.json").read_text())["metadata"] == {"output": "rho_b"}
+    (tmp_path / "other.json").write_text(json.dumps({"format": "demcal-gaussian-process-1"}))
+    with pytest.raises(ValueError, match=r"other\.json: not a linear-regression file"):
+        LinearSurrogate.load(tmp_path / "other.json")
+    with pytest.raises(ValueError, match=r"X must have shape \(n, 4\)"):
+        plane.predict_torch(torch.zeros(3, 5))
+
+
+def test_screen_with_best_takes_the_highest_cross_validated_r2() -> None:
+    table = pd.DataFrame(
+        {"cv_r2": [0.5, 0.77, -0.01], "cv_rmse": [38.5, 53.5, 56.2]},
+        index=["Bayesian", "Gaussian", "ANN"],
+    )
     assert screening_method(table, "best") == "Gaussian"
     assert screening_method(table, "network") == "ANN"
     table.loc["ANN", "cv_r2"] = 0.9
     assert screening_method(table, "best") == "ANN"
     assert screening_method(table, "process") == "Gaussian"
+    assert screening_method(table, "linear") == "Bayesian"
+    # The quick bulk density's case: the plane cross-validates best and its CV RMSE (38.5
+    # kg/m^3) is below the acceptance band (5 % of 1 760): it screens.
+    table.loc["Bayesian", "cv_r2"] = 0.963
+    assert screening_method(table, "best", tolerance=88.0) == "Bayesian"
+    # A plane that misses by more than the band does not, however its R^2 compares; nor
+    # without a band.
+    assert screening_method(table, "best", tolerance=30.0) == "ANN"
+    assert screening_method(table, "best") == "ANN"
+    # On a tie the network, then the process, is preferred.
+    table.loc["Gaussian", "cv_r2"] = 0.963
+    assert screening_method(table, "best", tolerance=88.0) == "Gaussian"
     # Without cross-validation the paper's network screens.
     table["cv_r2"] = np.nan
     assert screening_method(table, "best") == "ANN"
@@ -86,10 +131,16 @@ def test_training_writes_the_process_the_screening_loads(tmp_path: Path) -> None
     assert features_gp == features == trained.features
     # The process learnt from every usable row: 14 sets at four P (this rho_b varies with P).
     assert process.x_train.shape == (56, len(features))
-    best = load_screening_surrogate(model_path, "best")[2]
+    plane, features_lin, method = load_screening_surrogate(model_path, "linear")
+    assert isinstance(plane, LinearSurrogate) and method == "Bayesian"
+    assert features_lin == features
     table = trained.table4
-    expected = "Gaussian" if table.loc["Gaussian", "cv_r2"] > table.loc["ANN", "cv_r2"] else "ANN"
-    assert best == expected
+    best = load_screening_surrogate(model_path, "best")[2]
+    assert best == table.loc[["ANN", "Gaussian"], "cv_r2"].idxmax()
+    # With a band wider than every CV RMSE the plane competes too.
+    wide = 2.0 * float(table["cv_rmse"].max()) / float(table["y_mean"].iloc[0])
+    best = load_screening_surrogate(model_path, "best", experiment=None, tolerance=wide)[2]
+    assert best == table.loc[["ANN", "Gaussian", "Bayesian"], "cv_r2"].idxmax()
     # Both screen with the same inputs and agree where the data are (rho_b ~ 1500-2000).
     grid = torch.tensor([[0.5, 0.5, 3000.0, 1.0]], dtype=torch.float32)
     assert features == ["coefficientFriction", "coefficientRollingFriction", "density", "P"]

@@ -65,6 +65,14 @@ def test_round_ids_continue_the_numbering(config):
     assert round_case_ids(config, 1, "angle_of_repose") == ["c0007", "c0008", "c0009"]
     # two shear decks and one heap per set; two replicate seeds per verification
     assert runs_per_set(config) == 3 and verification_runs(config) == 6
+    heaps = {**config, "design": {**config["design"], "repose_replicates": 3}}
+    assert round_case_ids(heaps, 1, "angle_of_repose")[:4] == [
+        "c0007",
+        "c0007_r2",
+        "c0007_r3",
+        "c0008",
+    ]
+    assert runs_per_set(heaps) == 2 + 3
 
 
 def test_factorial_and_choices_are_refused(config):

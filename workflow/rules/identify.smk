@@ -13,8 +13,9 @@ FIGURES = {
 rule identify:
     input:
         models=expand(f"{RESULTS}/surrogates/{{output}}/model.pt", output=OUTPUTS_TRAINED),
-        # surrogate.screen_with may pick the process by its Table 4 row
+        # surrogate.screen_with may pick the process or the plane by its Table 4 row
         processes=expand(f"{RESULTS}/surrogates/{{output}}/process.json", output=OUTPUTS_TRAINED),
+        linears=expand(f"{RESULTS}/surrogates/{{output}}/linear.json", output=OUTPUTS_TRAINED),
         tables=expand(f"{RESULTS}/surrogates/{{output}}/table4.csv", output=OUTPUTS_TRAINED),
         experiment=config["experiment"],
         # for the first line of Table 5: can the model reach the measurement at all?

@@ -66,6 +66,7 @@ rule sequential_train_surrogate:
         model=f"{SEQ_ROUND}/surrogates/{{output}}/model.pt",
         table4=f"{SEQ_ROUND}/surrogates/{{output}}/table4.csv",
         process=f"{SEQ_ROUND}/surrogates/{{output}}/process.json",
+        linear=f"{SEQ_ROUND}/surrogates/{{output}}/linear.json",
     log:
         f"{LOGS}/sequential/round_{{round}}/surrogates/{{output}}.log",
     wildcard_constraints:
@@ -89,6 +90,9 @@ checkpoint sequential_identify:
         ],
         processes=lambda wc: [
             round_path(wc.round, f"surrogates/{o}/process.json") for o in ROUND_OUTPUTS
+        ],
+        linears=lambda wc: [
+            round_path(wc.round, f"surrogates/{o}/linear.json") for o in ROUND_OUTPUTS
         ],
         experiment=config["experiment"],
         dataset=f"{SEQ_ROUND}/dataset.csv",

@@ -15,6 +15,7 @@ rule train_surrogate:
         model=f"{RESULTS}/surrogates/{{output}}/model.pt",
         table4=f"{RESULTS}/surrogates/{{output}}/table4.csv",
         process=f"{RESULTS}/surrogates/{{output}}/process.json",
+        linear=f"{RESULTS}/surrogates/{{output}}/linear.json",
         sweep=f"{RESULTS}/surrogates/{{output}}/sweep.csv",
         cv_folds=f"{RESULTS}/surrogates/{{output}}/cv_folds.csv",
         parity_ann=report(
