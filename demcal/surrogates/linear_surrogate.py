@@ -13,7 +13,6 @@ needs: a JSON file and a float32 ``predict_torch``.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -24,7 +23,9 @@ import torch
 from sklearn.pipeline import Pipeline
 
 from demcal.surrogates.baselines import linear_coefficients
+from demcal.surrogates.grid_evaluation import evaluate_in_chunks
 from demcal.surrogates.log_inputs import take_logs
+from demcal.surrogates.surrogate_json import read_surrogate_json, write_surrogate_json
 
 #: Format tag of the file.
 LINEAR_FORMAT = "demcal-linear-regression-1"
@@ -109,20 +110,16 @@ class LinearSurrogate:
         -------
         torch.Tensor of float32, shape (n,)
         """
-        if X.ndim != 2 or X.shape[1] != len(self.features):
-            raise ValueError(f"X must have shape (n, {len(self.features)}), got {tuple(X.shape)}")
         # float64 inside: the intercept of a bulk density (~1e3) would eat float32 digits of
         # the small per-parameter terms.
         coef = torch.from_numpy(self.coef)
-        logs = list(self.log_inputs)
-        out = torch.empty(X.shape[0], dtype=torch.float32)
-        with torch.no_grad():
-            for start in range(0, X.shape[0], chunk_size):
-                chunk = X[start : start + chunk_size].to(torch.float64, copy=True)
-                if logs:
-                    chunk[:, logs] = chunk[:, logs].log()
-                out[start : start + chunk_size] = (chunk @ coef + self.intercept).to(torch.float32)
-        return out
+        return evaluate_in_chunks(
+            X,
+            len(self.features),
+            self.log_inputs,
+            chunk_size,
+            lambda chunk: chunk @ coef + self.intercept,
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable description (every number as a Python float)."""
@@ -136,9 +133,7 @@ class LinearSurrogate:
 
     def save(self, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
         """Write the plane as JSON (``metadata`` under its own key)."""
-        path = Path(path)
-        path.write_text(json.dumps({**self.to_dict(), "metadata": metadata or {}}) + "\n")
-        return path
+        return write_surrogate_json(path, self.to_dict(), metadata)
 
     @classmethod
     def load(cls, path: str | Path) -> LinearSurrogate:
@@ -149,10 +144,5 @@ class LinearSurrogate:
         ValueError
             If the file is not of this format or its slopes do not match its features.
         """
-        data = json.loads(Path(path).read_text())
-        if data.get("format") != LINEAR_FORMAT:
-            raise ValueError(
-                f"{path}: not a linear-regression file of format {LINEAR_FORMAT} "
-                f"(format {data.get('format')!r})"
-            )
-        return cls(**{k: data[k] for k in ("features", "log_inputs", "coef", "intercept")})
+        keys = ("features", "log_inputs", "coef", "intercept")
+        return cls(**read_surrogate_json(path, LINEAR_FORMAT, "linear-regression", keys))

@@ -16,7 +16,6 @@ scales. It is written as JSON: plain numbers, readable anywhere.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -26,7 +25,9 @@ import numpy.typing as npt
 import torch
 from sklearn.pipeline import Pipeline
 
+from demcal.surrogates.grid_evaluation import evaluate_in_chunks
 from demcal.surrogates.log_inputs import take_logs
+from demcal.surrogates.surrogate_json import read_surrogate_json, write_surrogate_json
 
 #: Format tag of the file.
 PROCESS_FORMAT = "demcal-gaussian-process-1"
@@ -152,30 +153,23 @@ class ProcessSurrogate:
         -------
         torch.Tensor of float32, shape (n,)
         """
-        if X.ndim != 2 or X.shape[1] != len(self.features):
-            raise ValueError(f"X must have shape (n, {len(self.features)}), got {tuple(X.shape)}")
         # float64 inside: the weights of a nearly noise-free process are large and of both
         # signs, so float32 kernels lose digits in the sum.
-        f64 = torch.float64
         scale = self.x_scale * self.length_scales
         shift = torch.from_numpy(self.x_mean / scale)
         inv = torch.from_numpy(1.0 / scale)
         xt = torch.from_numpy(self.x_train / self.length_scales)
         xt_sq = (xt**2).sum(1)
         weights = torch.from_numpy(self.signal_variance * self.y_std * self.alpha)
-        logs = list(self.log_inputs)
-        out = torch.empty(X.shape[0], dtype=torch.float32)
-        with torch.no_grad():
-            for start in range(0, X.shape[0], chunk_size):
-                # A copy: the caller's grid keeps its SI values.
-                chunk = X[start : start + chunk_size].to(f64, copy=True)
-                if logs:
-                    chunk[:, logs] = chunk[:, logs].log()
-                xs = chunk * inv - shift
-                sq = (xs**2).sum(1, keepdim=True) + xt_sq - 2.0 * xs @ xt.T
-                k = torch.exp(-0.5 * sq.clamp_min_(0.0))
-                out[start : start + chunk_size] = (k @ weights + self.y_mean).to(torch.float32)
-        return out
+
+        def posterior_mean(chunk: torch.Tensor) -> torch.Tensor:
+            xs = chunk * inv - shift
+            sq = (xs**2).sum(1, keepdim=True) + xt_sq - 2.0 * xs @ xt.T
+            return torch.exp(-0.5 * sq.clamp_min_(0.0)) @ weights + self.y_mean
+
+        return evaluate_in_chunks(
+            X, len(self.features), self.log_inputs, chunk_size, posterior_mean
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-serialisable description (every number as a Python float)."""
@@ -195,9 +189,7 @@ class ProcessSurrogate:
 
     def save(self, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
         """Write the process as JSON (``metadata`` under its own key)."""
-        path = Path(path)
-        path.write_text(json.dumps({**self.to_dict(), "metadata": metadata or {}}) + "\n")
-        return path
+        return write_surrogate_json(path, self.to_dict(), metadata)
 
     @classmethod
     def load(cls, path: str | Path) -> ProcessSurrogate:
@@ -208,12 +200,6 @@ class ProcessSurrogate:
         ValueError
             If the file is not a process of this format or its arrays disagree in shape.
         """
-        data = json.loads(Path(path).read_text())
-        if data.get("format") != PROCESS_FORMAT:
-            raise ValueError(
-                f"{path}: not a Gaussian-process file of format {PROCESS_FORMAT} "
-                f"(format {data.get('format')!r})"
-            )
         keys = (
             "features",
             "log_inputs",
@@ -226,4 +212,4 @@ class ProcessSurrogate:
             "y_mean",
             "y_std",
         )
-        return cls(**{k: data[k] for k in keys})
+        return cls(**read_surrogate_json(path, PROCESS_FORMAT, "Gaussian-process", keys))
