@@ -306,6 +306,8 @@ def test_replicates_add_only_the_new_runs(study):
     # from its own packing, before the dataset and everything after it are made again.
     config = yaml.safe_load((study / "config.yaml").read_text())
     config["design"]["replicates"] = 2
+    # the heaps follow design.replicates (tiny.yaml runs one heap per set)
+    config["design"]["repose_replicates"] = None
     twice = study / "config_replicates.yaml"
     twice.write_text(yaml.safe_dump(config))
     res = snakemake(study, "--dry-run", "--configfile", str(twice))
