@@ -24,7 +24,7 @@ from sklearn.pipeline import Pipeline
 
 from demcal.surrogates.baselines import linear_coefficients
 from demcal.surrogates.grid_evaluation import evaluate_in_chunks
-from demcal.surrogates.log_inputs import take_logs
+from demcal.surrogates.log_inputs import pipeline_log_columns, take_logs
 from demcal.surrogates.surrogate_json import read_surrogate_json, write_surrogate_json
 
 #: Format tag of the file.
@@ -76,8 +76,7 @@ class LinearSurrogate:
             Its ordered input names.
         """
         coef, intercept = linear_coefficients(pipeline)
-        log_step = pipeline.named_steps["log"]
-        return cls(features, (log_step.kw_args or {}).get("columns", ()), coef, intercept)
+        return cls(features, pipeline_log_columns(pipeline), coef, intercept)
 
     def predict(self, X: npt.ArrayLike) -> np.ndarray:
         """The plane's value, float64.
@@ -92,9 +91,7 @@ class LinearSurrogate:
         numpy.ndarray, shape (n,)
             Units of the bulk value.
         """
-        return self.intercept + take_logs(np.asarray(X, dtype=np.float64), self.log_inputs) @ (
-            self.coef
-        )
+        return self.intercept + take_logs(X, self.log_inputs) @ self.coef
 
     def predict_torch(self, X: torch.Tensor, chunk_size: int = 262_144) -> torch.Tensor:
         """The plane's value over many rows in float32, for screening candidate grids.

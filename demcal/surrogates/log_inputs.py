@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
+from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import FunctionTransformer
 
 from demcal.core.parameters import LOG_SCALE_PARAMETERS
@@ -88,3 +89,19 @@ def log_transformer(columns: Sequence[int]) -> FunctionTransformer:
     sklearn.preprocessing.FunctionTransformer
     """
     return FunctionTransformer(take_logs, kw_args={"columns": tuple(columns)})
+
+
+def pipeline_log_columns(pipeline: Pipeline) -> tuple[int, ...]:
+    """The columns the ``log`` step (:func:`log_transformer`) of a fitted pipeline takes.
+
+    Parameters
+    ----------
+    pipeline : sklearn.pipeline.Pipeline
+        With a step named ``log``.
+
+    Returns
+    -------
+    tuple of int
+    """
+    step = pipeline.named_steps["log"]
+    return tuple((step.kw_args or {}).get("columns", ()))

@@ -26,7 +26,7 @@ import torch
 from sklearn.pipeline import Pipeline
 
 from demcal.surrogates.grid_evaluation import evaluate_in_chunks
-from demcal.surrogates.log_inputs import take_logs
+from demcal.surrogates.log_inputs import pipeline_log_columns, take_logs
 from demcal.surrogates.surrogate_json import read_surrogate_json, write_surrogate_json
 
 #: Format tag of the file.
@@ -100,13 +100,12 @@ class ProcessSurrogate:
         features : sequence of str
             Its ordered input names.
         """
-        log_step = pipeline.named_steps["log"]
         scaler = pipeline.named_steps["scale"]
         gp = pipeline.named_steps["regressor"].gp_
         kernel = gp.kernel_
         return cls(
             features=features,
-            log_inputs=(log_step.kw_args or {}).get("columns", ()),
+            log_inputs=pipeline_log_columns(pipeline),
             x_mean=scaler.mean_,
             x_scale=scaler.scale_,
             x_train=gp.X_train_,
