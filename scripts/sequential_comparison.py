@@ -219,7 +219,14 @@ def main() -> None:
             sets = oneshot_sets(config, budget)
             work = mdir / f"oneshot_{budget}"
             one = deep_merge(base, {"sequential": {"enabled": False}})
-            one["design"] = {**one["design"], "kind": "sobol", "n": sets, "repose_extra_sets": 0}
+            one["design"] = {
+                **one["design"],
+                "kind": "sobol",
+                "n": sets,
+                "repose_extra_sets": 0,
+                "shear_extra_sets": 0,
+                "shared_stresses": "all",
+            }
             one_config = write_study_config(work, one, experiment)
             if not (work / "results" / "verification" / "verification.csv").is_file():
                 log = mdir / f"oneshot_{budget}.log"

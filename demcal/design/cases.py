@@ -99,18 +99,21 @@ def design_from_config(config: Mapping[str, Any]) -> pd.DataFrame:
 
     With ``design.repose_extra_sets`` = m > 0, the ``n`` shared sets are followed by m sets of
     a second design of the same kind and ranges drawn with ``design.seed + 1``, on which only
-    the angle of repose runs (:func:`case_ids`); the ids run on (``c0017 ...`` after 16).
+    the angle of repose runs; with ``design.shear_extra_sets`` = q > 0 by q sets of a third
+    design drawn with ``design.seed + 2``, on which only the shear cell runs, at one normal
+    stress each (:func:`case_ids`). The ids run on (``c0017 ...`` after 16).
     """
     section = config["design"]
     spec = design_spec(section)
-    table = build_design(spec)
-    extra = repose_extra_sets(config)
-    if not extra:
-        return table
-    more = build_design({**spec, "n": extra, "seed": int(section["seed"]) + 1})
-    both = pd.concat([table, more], ignore_index=True)
-    both[CASE_ID_COLUMN] = numbered_ids(len(both))
-    return both
+    parts = [build_design(spec)]
+    for offset, extra in enumerate((repose_extra_sets(config), shear_extra_sets(config)), 1):
+        if extra:
+            parts.append(build_design({**spec, "n": extra, "seed": int(section["seed"]) + offset}))
+    if len(parts) == 1:
+        return parts[0]
+    table = pd.concat(parts, ignore_index=True)
+    table[CASE_ID_COLUMN] = numbered_ids(len(table))
+    return table
 
 
 def repose_extra_sets(config: Mapping[str, Any]) -> int:
@@ -124,6 +127,17 @@ def repose_extra_sets(config: Mapping[str, Any]) -> int:
     if section.get("kind") == "factorial" or config.get("sequential", {}).get("enabled"):
         return 0
     return int(section.get("repose_extra_sets", 0))
+
+
+def shear_extra_sets(config: Mapping[str, Any]) -> int:
+    """Sets of the design on which only the shear cell runs, at one normal stress each.
+
+    0 for a factorial design and in a sequential study, as for :func:`repose_extra_sets`.
+    """
+    section = config["design"]
+    if section.get("kind") == "factorial" or config.get("sequential", {}).get("enabled"):
+        return 0
+    return int(section.get("shear_extra_sets", 0))
 
 
 def write_design(config: Mapping[str, Any], path: str | Path) -> pd.DataFrame:
@@ -153,14 +167,45 @@ def case_ids(config: Mapping[str, Any], design: pd.DataFrame, test: str) -> list
 
     Shear-cell cases run one pre-shear stress (``_s<k>``) and, with
     ``shear_cell.separate_runs``, one shear load P per deck (``_p<j>``); otherwise all P
-    values run as cycles in one deck. The last ``design.repose_extra_sets`` rows of the design
-    run only the angle of repose. Every case is followed by its replicate runs
+    values run as cycles in one deck. The design's rows are the ``n`` shared sets (both tests,
+    every stress unless ``design.shared_stresses`` is ``one``), then
+    ``design.repose_extra_sets`` rows that run only the angle of repose, then
+    ``design.shear_extra_sets`` rows that run only the shear cell at one stress each
+    (:func:`one_stress_each`). Every case is followed by its replicate runs
     (:func:`with_replicates`).
     """
+    ids = list(design[CASE_ID_COLUMN])
+    heaps, shears = repose_extra_sets(config), shear_extra_sets(config)
+    shared = ids[: len(ids) - heaps - shears]
     if test == "angle_of_repose":
-        return with_replicates(config, list(design[CASE_ID_COLUMN]))
-    shared = design[CASE_ID_COLUMN].iloc[: len(design) - repose_extra_sets(config)]
-    return with_replicates(config, list(shared), shear_suffixes(config))
+        return with_replicates(config, shared + ids[len(shared) : len(shared) + heaps])
+    extra = one_stress_each(config, ids[len(ids) - shears :] if shears else [])
+    if shared_stresses(config) == "one":
+        return one_stress_each(config, shared) + extra
+    return with_replicates(config, shared, shear_suffixes(config)) + extra
+
+
+def one_stress_each(config: Mapping[str, Any], bases: list[str]) -> list[str]:
+    """Shear-cell case ids of design rows ``bases`` at one pre-shear stress each: the j-th
+    (from 0) at stress number ``j mod len(shear_cell.normal_stresses)`` + 1, with all its P
+    values, each case followed by its replicate runs."""
+    suffixes = shear_suffixes(config)
+    n_stresses = len(config["shear_cell"]["normal_stresses"])
+    cases: list[str] = []
+    for j, base in enumerate(bases):
+        stress = f"_s{j % n_stresses + 1}"
+        one = [s for s in suffixes if s == stress or s.startswith(stress + "_")]
+        cases += with_replicates(config, [base], one)
+    return cases
+
+
+def shared_stresses(config: Mapping[str, Any]) -> str:
+    """``all`` or ``one``: the pre-shear stresses of the shared sets' shear-cell runs
+    (``design.shared_stresses``); ``all`` for a factorial design and a sequential study."""
+    section = config["design"]
+    if section.get("kind") == "factorial" or config.get("sequential", {}).get("enabled"):
+        return "all"
+    return str(section.get("shared_stresses", "all"))
 
 
 def shear_suffixes(config: Mapping[str, Any]) -> list[str]:

@@ -53,8 +53,14 @@ NOISE: dict[str, float] = {"mu_psh": 0.03, "mu_sh": 0.03, "rho_b": 0.01, "aor": 
 _MODEL = {
     "particles": {"distribution": "monodisperse"},
     "material": {"rolling_friction": False},
-    # The study does not measure the angle of repose: no heap-only sets.
-    "design": {"kind": "lhs", "repose_extra_sets": 0},
+    # The study does not measure the angle of repose: no heap-only sets. Every set runs every
+    # stress: how an effect changes with the stress is its signature.
+    "design": {
+        "kind": "lhs",
+        "repose_extra_sets": 0,
+        "shear_extra_sets": 0,
+        "shared_stresses": "all",
+    },
 }
 
 _PROFILES: dict[str, dict[str, Any]] = {

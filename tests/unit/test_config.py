@@ -373,6 +373,8 @@ WITHOUT_EFFECT = {
         "shear_cell.youngs_modulus_max",
         "discrepancy.candidates",
         "design.repose_extra_sets",
+        "design.shear_extra_sets",
+        "design.shared_stresses",
     },
 }
 

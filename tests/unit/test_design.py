@@ -324,10 +324,13 @@ def test_heap_only_sets_follow_the_shared_sets() -> None:
     quick = load_config(root / "config" / "config.yaml")
     n, extra = quick["design"]["n"], quick["design"]["repose_extra_sets"]
     assert (n, extra) == (16, 48)
-    design = design_from_config(quick)
+    heaps_only = {**quick, "design": {**quick["design"], "shear_extra_sets": 0}}
+    design = design_from_config(heaps_only)
     assert design["case_id"].tolist() == case_ids(n + extra)
     # The shared sets are the design without heap-only sets, unchanged.
-    alone = design_from_config({**quick, "design": {**quick["design"], "repose_extra_sets": 0}})
+    alone = design_from_config(
+        {**heaps_only, "design": {**heaps_only["design"], "repose_extra_sets": 0}}
+    )
     pd.testing.assert_frame_equal(design.iloc[:n], alone)
     # The heap-only sets are a Latin hypercube of their own (seed + 1) over the same box.
     heaps = design.iloc[n:]
@@ -336,9 +339,10 @@ def test_heap_only_sets_follow_the_shared_sets() -> None:
         assert low <= column.min() and column.max() <= high
         strata = np.floor((column - low) / (high - low) * extra).astype(int)
         assert sorted(strata.tolist()) == list(range(extra)), name
-    heap_runs = study_case_ids(quick, design, "angle_of_repose")
+    heap_runs = study_case_ids(heaps_only, design, "angle_of_repose")
     assert heap_runs[::2] == case_ids(n + extra)  # each followed by its second heap
-    shear = study_case_ids(quick, design, "shear_cell")
+    every = {**heaps_only, "design": {**heaps_only["design"], "shared_stresses": "all"}}
+    shear = study_case_ids(every, design, "shear_cell")
     assert shear == [f"{c}_s{k}" for c in case_ids(n) for k in (1, 2, 3)]
     # A factorial design and a sequential study's rounds choose every set for both tests: the
     # key is ignored there (a profile merged over the quick one inherits it).
@@ -349,13 +353,67 @@ def test_heap_only_sets_follow_the_shared_sets() -> None:
     assert len(design_from_config(sequential)) == n
 
 
+def test_shear_only_sets_run_one_stress_each_after_the_heap_only_sets() -> None:
+    root = Path(__file__).resolve().parents[2]
+    quick = load_config(root / "config" / "config.yaml")
+    n, heaps = quick["design"]["n"], quick["design"]["repose_extra_sets"]
+    # The quick study: 16 shared sets at one stress each, then 32 shear-only sets.
+    assert (quick["design"]["shared_stresses"], quick["design"]["shear_extra_sets"]) == ("one", 32)
+    design = design_from_config(quick)
+    assert design["case_id"].tolist() == case_ids(n + heaps + 32)
+    without = {**quick, "design": {**quick["design"], "shear_extra_sets": 0}}
+    # The shared and heap-only sets are those of the study without shear-only sets.
+    pd.testing.assert_frame_equal(design.iloc[: n + heaps], design_from_config(without))
+    # A Latin hypercube of their own (seed + 2), not a copy of the heap-only one.
+    extra = design.iloc[n + heaps :]
+    mu_s = extra["coefficientFriction"].to_numpy()
+    strata = np.floor((mu_s - 0.1) / 0.9 * 32).astype(int)
+    assert sorted(strata.tolist()) == list(range(32))
+    assert not np.isin(mu_s, design["coefficientFriction"].iloc[: n + heaps]).any()
+    # Heaps: the shared and heap-only sets, two heaps each; none on a shear-only set.
+    heap_runs = study_case_ids(quick, design, "angle_of_repose")
+    assert heap_runs == study_case_ids(without, design_from_config(without), "angle_of_repose")
+    # Shear cell: one stress per set in turn, shared sets first: 48 decks as for 16 x 3.
+    shear = study_case_ids(quick, design, "shear_cell")
+    ids = case_ids(n + heaps + 32)
+    rotate = [f"{c}_s{j % 3 + 1}" for j, c in enumerate(ids[:n])]
+    assert shear == rotate + [f"{c}_s{j % 3 + 1}" for j, c in enumerate(ids[n + heaps :])]
+    assert len(shear) == 48
+    row = case_row(quick, design, "shear_cell", shear[-1])  # c0096_s2
+    assert row["normal_stress"] == quick["shear_cell"]["normal_stresses"][1]
+    # Every stress for the shared sets; shear-only sets stay at one.
+    every = {**quick, "design": {**quick["design"], "shared_stresses": "all"}}
+    runs = study_case_ids(every, design, "shear_cell")
+    assert runs == runs_all(ids[:n]) + shear[n:]
+    # With one deck per P, a set runs every P of its stress; replicates follow.
+    split = {
+        **quick,
+        "design": {**quick["design"], "replicates": 2, "repose_replicates": 1},
+        "shear_cell": {**quick["shear_cell"], "separate_runs": True},
+    }
+    runs = study_case_ids(split, design, "shear_cell")
+    first = ids[n + heaps]
+    assert [r for r in runs if r.startswith(first)] == [
+        f"{first}{r}_s1_p{j}" for j in (1, 2, 3, 4) for r in ("", "_r2")
+    ]
+    # Ignored where every set runs both tests.
+    sequential = {**quick, "sequential": {**quick["sequential"], "enabled": True}}
+    assert len(design_from_config(sequential)) == n
+    assert study_case_ids(sequential, design.iloc[:n], "shear_cell") == runs_all(ids[:n])
+
+
+def runs_all(ids: list[str]) -> list[str]:
+    """Shear-cell decks of ``ids`` at all three quick stresses."""
+    return [f"{c}_s{k}" for c in ids for k in (1, 2, 3)]
+
+
 def test_replicates_follow_every_case_from_their_own_packing() -> None:
     root = Path(__file__).resolve().parents[2]
     quick = load_config(root / "config" / "config.yaml")
     # The quick study: one run of every shear deck, two heaps of every set.
     assert quick["design"]["replicates"] == 1 and quick["design"]["repose_replicates"] == 2
     design = design_from_config(quick)
-    sets = len(design)
+    sets = 16 + 48  # the sets that run the heap (the 32 shear-only sets do not)
     one = {t: study_case_ids(quick, design, t) for t in ("angle_of_repose", "shear_cell")}
     assert one["angle_of_repose"][:3] == ["c0001", "c0001_r2", "c0002"]
     assert len(one["angle_of_repose"]) == 2 * sets
@@ -368,11 +426,11 @@ def test_replicates_follow_every_case_from_their_own_packing() -> None:
     assert heaps[:4] == ["c0001", "c0001_r2", "c0001_r3", "c0002"]
     assert len(heaps) == 3 * sets
     shear = study_case_ids(three, design, "shear_cell")
-    assert shear[:4] == ["c0001_s1", "c0001_r2_s1", "c0001_r3_s1", "c0001_s2"]
+    assert shear[:4] == ["c0001_s1", "c0001_r2_s1", "c0001_r3_s1", "c0002_s2"]
     assert [c for c in shear if "_r" not in c] == one["shear_cell"]
     # ... and with it the heaps alone.
     heaps_only = {**quick, "design": {**shared, "replicates": 3, "repose_replicates": 1}}
-    assert study_case_ids(heaps_only, design, "angle_of_repose") == list(design["case_id"])
+    assert study_case_ids(heaps_only, design, "angle_of_repose") == list(design["case_id"])[:sets]
     assert study_case_ids(heaps_only, design, "shear_cell") == shear
     assert replicate_of("c0012_r3_s2") == ("c0012_s2", 3)
     assert replicate_of("c0012_s2") == ("c0012_s2", 1)

@@ -67,3 +67,25 @@ def test_script_names_a_missing_dataset_file(tmp_path: Path) -> None:
     res = _run("--dataset", str(tmp_path / "nope.csv"), "--out", str(tmp_path / "cv"))
     assert res.returncode != 0 and "nope.csv" in res.stderr
     assert not (tmp_path / "cv").exists()
+
+
+def test_script_scores_the_design_of_its_config_on_a_larger_dataset(tmp_path: Path) -> None:
+    # 30 heap sets on file; a design of the first 12 is scored on their runs alone.
+    _heaps(30, seed=4).to_csv(tmp_path / "heaps.csv", index=False)
+    config = yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text())
+    config["surrogate"] = {"hidden_sizes": [4, 5], "max_epochs": 100}
+    config["design"] = {**config["design"], "n": 12}
+    (tmp_path / "cfg.yaml").write_text(yaml.safe_dump(config))
+    out = tmp_path / "cv"
+    args = ("--dataset", str(tmp_path / "heaps.csv"), "--config", str(tmp_path / "cfg.yaml"))
+    res = _run(*args, "--design-cases", "--out", str(out))
+    assert res.returncode == 0, res.stderr
+    rows = (out / "cross_validation.md").read_text().splitlines()[2:]
+    assert {row.split("|")[4].strip() for row in rows} == {"12"}
+    # A design with cases the dataset lacks is refused before any training.
+    config["design"]["n"] = 40
+    (tmp_path / "cfg.yaml").write_text(yaml.safe_dump(config))
+    res = _run(*args, "--design-cases", "--out", str(tmp_path / "cv40"))
+    assert res.returncode != 0
+    assert "10 cases of the design" in res.stderr and "c0031" in res.stderr
+    assert not (tmp_path / "cv40").exists()
