@@ -311,15 +311,20 @@ REPLICATE_SEED_STEP = 1000
 _REPLICATE_KEY = re.compile(r"identified(?P<k>\d*)(_s\d+(_p\d+)?)?")
 
 
-def verification_bases(config: Mapping[str, Any]) -> list[str]:
-    """Base ids of the replicate verification runs: ``identified``, ``identified2``, ..."""
-    seeds = int((config.get("verification") or {}).get("seeds", 1))
-    return ["identified"] + [f"identified{k}" for k in range(2, seeds + 1)]
+def verification_bases(config: Mapping[str, Any], test: str = "shear_cell") -> list[str]:
+    """Base ids of the replicate verification runs of ``test``: ``identified``,
+    ``identified2``, ... (``verification.seeds``; for the angle of repose
+    ``verification.repose_seeds`` where given)."""
+    section = config.get("verification") or {}
+    seeds = section.get("seeds", 1)
+    if test == "angle_of_repose" and section.get("repose_seeds") is not None:
+        seeds = section["repose_seeds"]
+    return ["identified"] + [f"identified{k}" for k in range(2, int(seeds) + 1)]
 
 
 def verification_case_ids(config: Mapping[str, Any], test: str) -> list[str]:
     """Ids of the verification runs at the identified set (every replicate, every load)."""
-    bases = verification_bases(config)
+    bases = verification_bases(config, test)
     if test == "angle_of_repose":
         return bases
     return [f"{base}{suffix}" for base in bases for suffix in shear_suffixes(config)]

@@ -95,11 +95,6 @@ def round_case_ids(config: Mapping[str, Any], round_no: int, test: str) -> list[
     return with_replicates(config, bases, shear_suffixes(config))
 
 
-def decks_per_set(config: Mapping[str, Any]) -> int:
-    """Decks of one parameter set: its shear-cell decks and one heap."""
-    return len(shear_suffixes(config)) + 1
-
-
 def runs_per_set(config: Mapping[str, Any]) -> int:
     """DEM runs of one parameter set: each shear-cell deck ``design.replicates`` times, the
     heap ``design.repose_replicates`` times."""
@@ -108,8 +103,9 @@ def runs_per_set(config: Mapping[str, Any]) -> int:
 
 
 def verification_runs(config: Mapping[str, Any]) -> int:
-    """DEM runs of one verification (every replicate of every deck)."""
-    return len(verification_bases(config)) * decks_per_set(config)
+    """DEM runs of one verification (every replicate of every deck, the heaps counted apart)."""
+    shear = len(verification_bases(config)) * len(shear_suffixes(config))
+    return shear + len(verification_bases(config, "angle_of_repose"))
 
 
 def round_dataset(

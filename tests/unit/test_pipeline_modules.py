@@ -87,6 +87,15 @@ def test_verification_case_uses_identified_means(config):
     assert len(verification_case_ids(replicated, "shear_cell")) == 3 * len(
         verification_case_ids(config, "shear_cell")
     )
+    # Heaps may replicate apart: nine heaps beside three runs of every shear deck.
+    heaps = {**config, "verification": {"seeds": 3, "repose_seeds": 9}}
+    assert verification_case_ids(heaps, "angle_of_repose")[-2:] == ["identified8", "identified9"]
+    assert verification_case_ids(heaps, "shear_cell") == verification_case_ids(
+        replicated, "shear_cell"
+    )
+    assert verification_case(config, identified, "angle_of_repose", "identified9")["seed"] == (
+        config["seed"] + 8 * REPLICATE_SEED_STEP
+    )
     with pytest.raises(KeyError, match="not a verification case"):
         replicate_seed(config, "c0001")
     with pytest.raises(ValueError, match="no parameter set"):

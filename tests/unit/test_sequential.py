@@ -73,6 +73,8 @@ def test_round_ids_continue_the_numbering(config):
         "c0008",
     ]
     assert runs_per_set(heaps) == 2 + 3
+    nine = {**config, "verification": {**config["verification"], "repose_seeds": 9}}
+    assert verification_runs(nine) == 2 * 2 + 9
 
 
 def test_factorial_and_choices_are_refused(config):
