@@ -116,28 +116,29 @@ def design_from_config(config: Mapping[str, Any]) -> pd.DataFrame:
     return table
 
 
-def repose_extra_sets(config: Mapping[str, Any]) -> int:
-    """Sets of the design on which only the angle of repose runs.
+def every_set_runs_everything(config: Mapping[str, Any]) -> bool:
+    """Whether every set of the design runs both tests at every stress: a factorial design,
+    and a sequential study, whose rounds choose each set for both tests. The keys that thin a
+    design (``repose_extra_sets``, ``shear_extra_sets``, ``shared_stresses``) are ignored
+    there, as they are when a profile merged over the quick one inherits them."""
+    kind = config["design"].get("kind")
+    return kind == "factorial" or bool(config.get("sequential", {}).get("enabled"))
 
-    0 for a factorial design and in a sequential study, whose rounds choose every set for both
-    tests: the key is ignored there, as it is when a profile merged over the quick one
-    inherits it.
-    """
-    section = config["design"]
-    if section.get("kind") == "factorial" or config.get("sequential", {}).get("enabled"):
+
+def repose_extra_sets(config: Mapping[str, Any]) -> int:
+    """Sets of the design on which only the angle of repose runs (0 where
+    :func:`every_set_runs_everything`)."""
+    if every_set_runs_everything(config):
         return 0
-    return int(section.get("repose_extra_sets", 0))
+    return int(config["design"].get("repose_extra_sets", 0))
 
 
 def shear_extra_sets(config: Mapping[str, Any]) -> int:
-    """Sets of the design on which only the shear cell runs, at one normal stress each.
-
-    0 for a factorial design and in a sequential study, as for :func:`repose_extra_sets`.
-    """
-    section = config["design"]
-    if section.get("kind") == "factorial" or config.get("sequential", {}).get("enabled"):
+    """Sets of the design on which only the shear cell runs, at one normal stress each (0 where
+    :func:`every_set_runs_everything`)."""
+    if every_set_runs_everything(config):
         return 0
-    return int(section.get("shear_extra_sets", 0))
+    return int(config["design"].get("shear_extra_sets", 0))
 
 
 def write_design(config: Mapping[str, Any], path: str | Path) -> pd.DataFrame:
@@ -201,11 +202,10 @@ def one_stress_each(config: Mapping[str, Any], bases: list[str]) -> list[str]:
 
 def shared_stresses(config: Mapping[str, Any]) -> str:
     """``all`` or ``one``: the pre-shear stresses of the shared sets' shear-cell runs
-    (``design.shared_stresses``); ``all`` for a factorial design and a sequential study."""
-    section = config["design"]
-    if section.get("kind") == "factorial" or config.get("sequential", {}).get("enabled"):
+    (``design.shared_stresses``; ``all`` where :func:`every_set_runs_everything`)."""
+    if every_set_runs_everything(config):
         return "all"
-    return str(section.get("shared_stresses", "all"))
+    return str(config["design"].get("shared_stresses", "all"))
 
 
 def shear_suffixes(config: Mapping[str, Any]) -> list[str]:
