@@ -5,6 +5,7 @@ values with the measurements.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -13,7 +14,11 @@ import pandas as pd
 
 from demcal.core.experiments import load_experiment
 from demcal.design.cases import verification_case
-from demcal.identification.verification import verification_table
+from demcal.identification.verification import (
+    engine_columns,
+    scatter_columns,
+    verification_table,
+)
 from demcal.virtual_tests.deck import render_case
 
 
@@ -88,6 +93,61 @@ def surrogate_column(table: pd.DataFrame, predicted: list[Mapping[str, Any]]) ->
     return pd.Series([lookup.get(_key(*row), float("nan")) for row in rows], index=table.index)
 
 
+def _condition(row: Mapping[str, Any]) -> str:
+    if pd.isna(row.get("normal_stress")):
+        return str(row["observable"])
+    return f"{row['observable']} ({float(row['normal_stress']):.6g} Pa, P {float(row['P']):g})"
+
+
+def dem_verdict(table: pd.DataFrame, engine: str, tolerance: float) -> str:
+    """One line: whether one engine's verification runs reproduce every measured value.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame, shape (n_measured, ...)
+        From :func:`demcal.identification.verification.verification_table`.
+    engine : str
+        The engine whose columns (``dem_<engine>``, ``dem_sd_<engine>``, ``runs_<engine>``,
+        ``deviation_<engine>``) are read.
+    tolerance : float
+        The relative tolerance (e.g. 0.05).
+
+    Returns
+    -------
+    str
+        A single line; a miss names every value outside the tolerance with the runs' mean, its
+        standard error over the replicate runs and the measurement.
+    """
+    dem, deviation, _ = engine_columns(engine)
+    sd, runs = scatter_columns(engine)
+    misses = []
+    for _, row in table.iterrows():
+        if row[deviation] <= tolerance:
+            continue
+        if not row[runs] or pd.isna(row[dem]):
+            misses.append(f"{_condition(row)}: no finished run")
+            continue
+        spread = ""
+        if row[runs] > 1 and not pd.isna(row[sd]):
+            error = float(row[sd]) / math.sqrt(float(row[runs]))
+            spread = f" +- {error:.3g} (standard error of {int(row[runs])} runs)"
+        misses.append(
+            f"{_condition(row)} {float(row[dem]):.4g}{spread} against {float(row['measured']):.4g}"
+            f" ({float(row[deviation]):.1%})"
+        )
+    if not misses:
+        worst = table.loc[table[deviation].idxmax()]
+        return (
+            f"The DEM runs on {engine} reproduce every measured value within the "
+            f"{tolerance:.0%} tolerance (largest deviation: {_condition(worst)}, "
+            f"{float(worst[deviation]):.1%})."
+        )
+    return (
+        f"**The DEM runs on {engine} miss {len(misses)} of the {len(table)} measured values by "
+        f"more than the {tolerance:.0%} tolerance**: " + "; ".join(misses) + "."
+    )
+
+
 def write_verification_table(
     bulk_files: Mapping[str, Iterable[str | Path]],
     experiment_file: str | Path,
@@ -119,7 +179,8 @@ def write_verification_table(
         The identified-set record; its reachability verdict (``reach``, written by
         :func:`demcal.identification.identify.identify`) becomes the first line of the text,
         followed by whether the surrogates accept the mean set itself (``mean_set``); their
-        predictions there (``predicted_at_mean``) become the column ``surrogate``.
+        predictions there (``predicted_at_mean``) become the column ``surrogate``. Then, for
+        every engine, whether its runs reproduce every measured value (:func:`dem_verdict`).
 
     Returns
     -------
@@ -136,10 +197,11 @@ def write_verification_table(
     if record.get("predicted_at_mean"):
         table[SURROGATE_COLUMN] = surrogate_column(table, record["predicted_at_mean"])
     table.to_csv(csv, index=False)
-    lines = ["# Verification: DEM at the identified mean set vs measurement", ""]
     lines = [
         *(f"{record[key]}\n" for key in ("reach", "mean_set") if record.get(key)),
-        *lines,
+        *(f"{dem_verdict(table, engine, float(tolerance))}\n" for engine in runs),
+        "# Verification: DEM at the identified mean set vs measurement",
+        "",
     ]
     lines.append(
         "Engines (columns dem_<engine>: mean over replicate runs, dem_sd_<engine>: their standard "

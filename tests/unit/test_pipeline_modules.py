@@ -616,6 +616,11 @@ def test_write_verification_table_lists_engines_and_failed_runs(tmp_path):
     text = (tmp_path / "v.md").read_text()
     assert "- liggghts: `liggghts -in {deck}`, 2 thread(s)" in text
     assert "FAILED on bundled: shear_cell identified_s1 (ERROR: unstable)" in text
+    # Each engine's verdict comes first; a failed run is a miss with no value.
+    verdicts = text.splitlines()[:4]
+    assert verdicts[0].startswith("**The DEM runs on liggghts miss")
+    assert verdicts[2].startswith("**The DEM runs on bundled miss 2 of the 3 measured values")
+    assert "mu_psh (2029 Pa, P 1): no finished run" in verdicts[2] and "aor" not in verdicts[2]
     assert pd.read_csv(tmp_path / "v.csv").shape == table.shape
     assert "surrogate" not in table  # no identified-set record given
 
@@ -651,4 +656,9 @@ def test_verification_table_shows_the_surrogates_at_the_verified_set(tmp_path):
     assert rows.loc["aor", "dem_configured"] == 35.8
     text = (tmp_path / "v.md").read_text().splitlines()
     assert text[:4] == ["REACH LINE", "", "MEAN LINE", ""]
+    # One run: the angle's 35.8 deg misses 38.85 by 7.9 %, rho_b's 1738 is within 1.3 %.
+    assert text[4] == (
+        "**The DEM runs on configured miss 1 of the 2 measured values by more than the 5% "
+        "tolerance**: aor 35.8 against 38.85 (7.9%)."
+    )
     assert any(line.startswith("surrogate: the surrogates' prediction") for line in text)
