@@ -177,10 +177,10 @@ def case_ids(config: Mapping[str, Any], design: pd.DataFrame, test: str) -> list
     """
     ids = list(design[CASE_ID_COLUMN])
     heaps, shears = repose_extra_sets(config), shear_extra_sets(config)
+    if test == "angle_of_repose":  # every row but the shear-only ones, which come last
+        return with_replicates(config, ids[: len(ids) - shears])
     shared = ids[: len(ids) - heaps - shears]
-    if test == "angle_of_repose":
-        return with_replicates(config, shared + ids[len(shared) : len(shared) + heaps])
-    extra = one_stress_each(config, ids[len(ids) - shears :] if shears else [])
+    extra = one_stress_each(config, ids[len(ids) - shears :])
     if shared_stresses(config) == "one":
         return one_stress_each(config, shared) + extra
     return with_replicates(config, shared, shear_suffixes(config)) + extra

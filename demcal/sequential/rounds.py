@@ -32,7 +32,7 @@ from demcal.bulk.dataset import collect
 from demcal.design.cases import (
     design_replicates,
     shear_suffixes,
-    verification_bases,
+    verification_case_ids,
     with_replicates,
 )
 
@@ -104,8 +104,7 @@ def runs_per_set(config: Mapping[str, Any]) -> int:
 
 def verification_runs(config: Mapping[str, Any]) -> int:
     """DEM runs of one verification (every replicate of every deck, the heaps counted apart)."""
-    shear = len(verification_bases(config)) * len(shear_suffixes(config))
-    return shear + len(verification_bases(config, "angle_of_repose"))
+    return sum(len(verification_case_ids(config, t)) for t in ("shear_cell", "angle_of_repose"))
 
 
 def round_dataset(
