@@ -181,14 +181,43 @@ class SizeDistribution:
             raise ValueError(f"scale factor must be positive, got {factor}")
         return SizeDistribution(self.radii * factor, self.mass_fractions)
 
-    def truncated(self, k: int) -> SizeDistribution:
-        """Only the ``k`` largest classes, their mass fractions renormalised to sum to 1."""
-        if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 1 <= k:
-            raise ValueError(f"number of classes to keep must be an integer >= 1, got {k!r}")
+    def truncated(self, k: float) -> SizeDistribution:
+        """The ``k`` largest classes, mass fractions renormalised to sum to 1.
+
+        A fractional ``k`` keeps ``floor(k)`` classes whole and the share ``k - floor(k)`` of
+        the mass of the next finer class, so that the amount of fines, and with it the size
+        spread, grows continuously with ``k`` (a sieve cut between two sieves).
+
+        Parameters
+        ----------
+        k : float
+            Number of classes kept, ``1 <= k <= n_classes``.
+
+        Returns
+        -------
+        SizeDistribution
+            ``ceil(k)`` classes in the original order.
+
+        Raises
+        ------
+        ValueError
+            For ``k`` outside ``[1, n_classes]`` or not a finite number, or no mass kept.
+        """
+        if isinstance(k, bool) or not isinstance(k, int | float | np.integer | np.floating):
+            raise ValueError(f"number of classes to keep must be a number >= 1, got {k!r}")
+        if not (math.isfinite(k) and k >= 1):
+            raise ValueError(f"number of classes to keep must be a number >= 1, got {k!r}")
         if k > self.n_classes:
             raise ValueError(f"cannot keep {k} classes of a {self.n_classes}-class distribution")
-        keep = np.sort(np.argsort(self.radii)[::-1][:k])  # k largest, original order
-        fractions = self.mass_fractions[keep]
+        whole = math.floor(k)
+        share = float(k) - whole
+        n_kept = whole + (1 if share > 0 else 0)
+        order = np.argsort(self.radii)[::-1][:n_kept]  # largest first
+        fractions = self.mass_fractions.copy()
+        if share > 0:
+            fractions[order[-1]] *= share
+        keep = np.sort(order)  # original order
+        fractions = fractions[keep]
         if fractions.sum() <= 0:
             raise ValueError(f"the {k} largest classes hold no mass")
         return SizeDistribution(self.radii[keep], fractions / fractions.sum())
@@ -223,15 +252,16 @@ def from_sieve_analysis(
     return SizeDistribution(openings * unit / 2.0, fractions)
 
 
-def sinter_fines(scale: float = 1.0, n_largest: int | None = None) -> SizeDistribution:
+def sinter_fines(scale: float = 1.0, n_largest: float | None = None) -> SizeDistribution:
     """The sinter-fines distribution of the paper (see the module notes for the size mapping).
 
     Parameters
     ----------
     scale : float
         Factor applied to all radii (coarse graining), default 1.
-    n_largest : int, optional
-        Keep only this many of the largest classes (mass fractions renormalised).
+    n_largest : float, optional
+        Keep only this many of the largest classes (mass fractions renormalised; a fractional
+        part keeps that share of the next finer class, see `SizeDistribution.truncated`).
 
     Returns
     -------
@@ -254,7 +284,7 @@ def size_distribution(particles: Mapping[str, Any]) -> SizeDistribution:
     particles : mapping
         ``distribution`` ("monodisperse" or "sinter_fines"), ``radius`` (m, monodisperse),
         ``scale`` (-, factor on the sinter-fines radii) and ``classes`` (number of the largest
-        sieve classes kept, 1-6).
+        sieve classes kept, 1-6; a fractional part keeps that share of the next finer class).
 
     Returns
     -------
@@ -273,7 +303,7 @@ def size_distribution(particles: Mapping[str, Any]) -> SizeDistribution:
         return monodisperse(positive(get(particles, "radius", "particles"), "particles.radius"))
     if kind == "sinter_fines":
         scale = positive(get(particles, "scale", "particles"), "particles.scale")
-        classes = int(get(particles, "classes", "particles"))
+        classes = float(get(particles, "classes", "particles"))
         if not 1 <= classes <= 6:
             raise SetupError(f"configuration: 'particles.classes' must be in 1..6, got {classes}")
         return sinter_fines(scale=scale, n_largest=classes)

@@ -132,7 +132,9 @@ def test_extended_design_adds_the_effect_axis(study):
     cands = by_name(study)
     table = extended_design(study, cands["polydispersity"], 9, 5)
     assert list(table["case_id"]) == [f"e{k:04d}" for k in range(1, 10)]
-    assert set(table["sizeClasses"]) <= set(range(1, 7)) and table["sizeClasses"].nunique() > 2
+    # A continuous axis: nine distinct numbers of classes over [1, 6], fractional ones too.
+    assert table["sizeClasses"].between(1, 6).all() and table["sizeClasses"].nunique() == 9
+    assert (table["sizeClasses"] % 1 != 0).any()
     assert table["coefficientFriction"].between(0.1, 0.9).all()
     assert (table["coefficientRestitution"] == 0.7).all()
     cohesion = extended_design(study, cands["cohesion"], 4, 5)

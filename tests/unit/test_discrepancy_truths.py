@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
+from demcal.core.config import load_config
 from demcal.discrepancy.truths import (
     MAX_EFFECT_FRACTION,
     draw_truth,
     load_truth_spec,
     truth_config,
 )
+from demcal.particles.size_distribution import size_distribution
 
 ROOT = Path(__file__).resolve().parents[2]
 TRUTHS = ROOT / "config" / "experiments" / "truth"
@@ -165,3 +169,26 @@ def test_an_outside_effect_switches_the_configuration_per_profile() -> None:
         assert {
             k: v for k, v in runs["shear_cell"].items() if k != "youngs_modulus_per_stress"
         } == {k: v for k, v in config["shear_cell"].items() if k != "youngs_modulus_per_stress"}
+
+
+def test_shipped_polydispersity_truths_spread_over_the_draw_span() -> None:
+    # As a whole number the draw could only give 3 classes; the shipped catalogues draw a
+    # continuous number of sieve classes, clear of the probes 2, 4 and 6.
+    spec = load_truth_spec(TRUTHS / "hidden_polydispersity.yaml")
+    for name in ("tiny", "config"):
+        config = yaml.safe_load((ROOT / "config" / f"{name}.yaml").read_text())
+        if name == "config":
+            config["profile"] = "quick"
+        drawn = np.array([draw_truth(spec, config, seed).magnitude for seed in range(101, 121)])
+        assert np.all((drawn >= 1.75) & (drawn <= 4.5)), (name, drawn)
+        assert np.min(np.abs(drawn[:, None] - np.array([2.0, 4.0, 6.0])), axis=1).min() > 0.25
+        assert np.unique(np.round(drawn, 6)).size == drawn.size
+        assert drawn.max() - drawn.min() > 1.5, (name, drawn)
+        # The truth runs keep the fraction: part of the next finer sieve class.
+        validated = load_config(ROOT / "config" / f"{name}.yaml")
+        validated["profile"] = config["profile"]
+        truth = draw_truth(spec, validated, 101)
+        particles = truth_config(truth, validated)["particles"]
+        assert particles["classes"] == truth.magnitude
+        dist = size_distribution(particles)
+        assert dist.n_classes == math.ceil(truth.magnitude) > truth.magnitude

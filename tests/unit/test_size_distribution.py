@@ -106,6 +106,21 @@ def test_truncation_keeps_largest_classes_renormalised() -> None:
         sinter_fines(n_largest=0)
 
 
+def test_fractional_truncation_keeps_part_of_the_next_class() -> None:
+    # 2.5 classes: the two largest whole and half the mass retained on the 1.25 mm sieve.
+    dist = sinter_fines(n_largest=2.5)
+    np.testing.assert_allclose(dist.radii, [1.0 * MM, 0.8 * MM, 0.625 * MM])
+    kept = np.array([0.4539, 0.1571, 0.5 * 0.1033])
+    np.testing.assert_allclose(dist.mass_fractions, kept / kept.sum())
+    # The share of fines grows continuously between whole numbers: smaller mean particle.
+    volumes = [sinter_fines(n_largest=k).mean_particle_volume for k in (3.0, 3.25, 3.5, 3.75, 4.0)]
+    assert np.all(np.diff(volumes) < 0)
+    assert sinter_fines(n_largest=3.0).n_classes == 3
+    for bad in (float("nan"), 6.5, True):
+        with pytest.raises(ValueError, match="classes"):
+            sinter_fines(n_largest=bad)
+
+
 def test_monodisperse() -> None:
     dist = monodisperse(0.732 * MM)
     assert dist.mean_radius == pytest.approx(0.732 * MM)
