@@ -9,12 +9,14 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from demcal.core.experiments import Experiment, load_experiment
 from demcal.core.provenance import write_sidecar
 from demcal.discrepancy.candidates import REFERENCE_CASE
 from demcal.discrepancy.dem_check import held_out_experiment, replicate_bases
+from demcal.discrepancy.effect_verdict import dem_noise_bound, effect_verdict
 from demcal.discrepancy.observations import observation_table
 from demcal.discrepancy.plan import VERIFICATION_CASE
 from demcal.discrepancy.report import (
@@ -26,39 +28,7 @@ from demcal.discrepancy.report import (
 )
 from demcal.discrepancy.run_results import read_runs, replicate_statistics
 
-__all__ = ["NOISE_GAP", "dem_confirms", "gap_title", "held_out_rows", "show", "write_before_after"]
-
-#: A gap (root mean square of z) at or below this is within the noise.
-NOISE_GAP = 1.0
-
-
-def dem_confirms(
-    dem_gap_before: float,
-    dem_gap_after: float,
-    held_out_before: float = math.nan,
-    held_out_after: float = math.nan,
-) -> bool:
-    """Whether the DEM runs confirm an added effect.
-
-    The extended model at its identified point must be closer to the fitted measurements than
-    the current model at theta* (replicate means), and at held-out loads (when there are any)
-    within the noise (gap <= :data:`NOISE_GAP`) or closer than before. A proxy that only fits
-    the surrogates, or only the loads it was fitted on, fails.
-
-    Parameters
-    ----------
-    dem_gap_before, dem_gap_after : float
-        DEM gaps on the fitted loads, -.
-    held_out_before, held_out_after : float
-        DEM gaps on the held-out loads, -; NaN when there are none.
-    """
-    if not (math.isfinite(dem_gap_before) and math.isfinite(dem_gap_after)):
-        return False
-    if dem_gap_after >= dem_gap_before:
-        return False
-    if math.isfinite(held_out_after):
-        return held_out_after <= max(NOISE_GAP, held_out_before)
-    return True
+__all__ = ["gap_title", "held_out_rows", "show", "write_before_after"]
 
 
 def held_out_rows(
@@ -154,6 +124,15 @@ def show(
     gap_before = gap_of(fitted["z_before_common"])
     gap_after = gap_of(fitted["z_after_common"])
     dem_after_gap = gap_of(fitted["z_dem_after"])
+    n_dem = int(np.isfinite(fitted["z_dem_after"].to_numpy(dtype=float)).sum())
+    verdict = effect_verdict(
+        summary["dem_gap_before"],
+        dem_after_gap,
+        summary["held_out_dem_gap_before"],
+        gap_of(held["z_dem_after"]),
+        n_dem,
+        summary["alpha"],
+    )
     summary.update(
         {
             "parameter": recal_rec["parameter"],
@@ -168,12 +147,9 @@ def show(
             if dem_after_gap > 0
             else math.inf,
             "held_out_dem_gap_after": gap_of(held["z_dem_after"]),
-            "dem_confirmed": dem_confirms(
-                summary["dem_gap_before"],
-                dem_after_gap,
-                summary["held_out_dem_gap_before"],
-                gap_of(held["z_dem_after"]),
-            ),
+            "dem_values": n_dem,
+            "dem_gap_bound": dem_noise_bound(n_dem, summary["alpha"]) if n_dem else math.nan,
+            "dem_verdict": verdict,
             "verdict_after": recal_rec["verdict"],
             "screening_after": recal_rec.get("screening"),
         }

@@ -14,6 +14,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from demcal.discrepancy.effect_verdict import CONFIRMED, GAP_REMAINS
 from demcal.discrepancy.find import FindResult
 from demcal.discrepancy.observations import format_stress
 
@@ -338,10 +339,23 @@ def verification_markdown(table: pd.DataFrame, summary: Mapping[str, Any]) -> st
             lines.append(markdown_table(_dem_columns(table, ["before"]), ".4g"))
         return "\n".join(lines) + "\n"
     params = ", ".join(f"{k} = {v:.4g}" for k, v in summary["identified"].items())
-    if summary.get("dem_confirmed"):
+    verdict = summary.get("dem_verdict")
+    if verdict == CONFIRMED:
         lines += [
             f"**The DEM runs confirm {summary['winner']}**: closer to the measurements "
-            "than the current model, held-out loads within the noise or closer.",
+            "than the current model, held-out loads within the noise or closer, and the gap "
+            "left within the noise.",
+            "",
+        ]
+    elif verdict == GAP_REMAINS:
+        lines += [
+            f"**The DEM runs show {summary['winner']} closing part of the gap, not all of "
+            f"it**: closer to the measurements than the current model and held-out loads "
+            f"within the noise or closer, but the DEM gap left, "
+            f"{summary['dem_gap_after']:.3f}, is more than noise explains (at most "
+            f"{summary['dem_gap_bound']:.3f} over {summary['dem_values']} values, alpha = "
+            f"{summary['alpha']:g}). {summary['winner']} explains part of the discrepancy or "
+            "stands in for an effect the catalogue lacks; something is still missing.",
             "",
         ]
     else:

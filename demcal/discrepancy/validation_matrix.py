@@ -26,12 +26,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 import yaml
 
 from demcal.core.config import validate_config
 from demcal.core.snakemake_run import run_snakemake
-from demcal.discrepancy.before_after import dem_confirms
+from demcal.discrepancy.effect_verdict import CONFIRMED, effect_verdict
 from demcal.discrepancy.report import markdown_table
 from demcal.discrepancy.synthetic import (
     study_config,
@@ -87,7 +88,7 @@ REPORT_COLUMNS = (
     "p_runner_up",
     *GAP_COLUMNS,
     "magnitude_ratio",
-    "dem_confirmed",
+    "dem_verdict",
 )
 
 
@@ -260,6 +261,7 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
         outcome = f"{AMBIGUOUS}: {pair[0]} / {pair[1]}"
     else:
         outcome = NOT_EXPLAINED
+    verdict = _dem_verdict(summary, out)
     magnitude = summary.get("magnitude")
     truth_magnitude = truth.get("magnitude")
     ratio = math.nan
@@ -273,8 +275,8 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
         "truth_friction": truth["parameters"].get("coefficientFriction", nan),
         "truth_magnitude": truth_magnitude if truth_magnitude is not None else nan,
         "outcome": outcome,
-        "correct": _correct(case, outcome, summary),
-        "dem_confirmed": _confirmed(summary),
+        "correct": _correct(case, outcome, verdict),
+        "dem_verdict": verdict,
         "shortlisted": case.kind == "catalogue" and (outcome == case.hidden or case.hidden in pair),
         "p_find": summary["p_value"],
         "p_effect": ranking.get("p_effect", nan) if ranking.get("ran", True) else nan,
@@ -290,28 +292,40 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
     }
 
 
-def _correct(case: MatrixCase, outcome: str, summary: Mapping[str, Any]) -> bool:
+def _correct(case: MatrixCase, outcome: str, verdict: str | None) -> bool:
     if case.kind == "catalogue":
         return outcome == case.hidden
     if case.kind == "nothing":
         return outcome == NOTHING
     # Outside the catalogue: not explained (ambiguous included), nothing visible, or a proxy
-    # whose DEM runs show that it does not explain the data.
+    # whose DEM runs do not show it explaining the data (not closer, or a gap left above noise).
     if outcome in (NOT_EXPLAINED, NOTHING) or outcome.startswith(AMBIGUOUS):
         return True
-    return _confirmed(summary) is False
+    return verdict is not None and verdict != CONFIRMED
 
 
-def _confirmed(summary: Mapping[str, Any]) -> bool | None:
-    """Whether the DEM check confirmed the named effect (None when none was added)."""
+def _dem_verdict(summary: Mapping[str, Any], out: Path) -> str | None:
+    """The DEM check's verdict on the added effect (None when none was added).
+
+    Derived from the study's gaps, with the number of fitted values from its
+    ``gap_before_after.csv`` where the summary does not give it, so that studies run before
+    the verdict had three outcomes are scored alike.
+    """
     if "dem_gap_after" not in summary:
         return None
+    n = summary.get("dem_values")
+    if n is None:
+        table = pd.read_csv(out / "gap_before_after.csv")
+        fitted = table[~table["held_out"].astype(bool)]
+        n = int(np.isfinite(fitted["z_dem_after"].to_numpy(dtype=float)).sum())
     nan = math.nan
-    return dem_confirms(
+    return effect_verdict(
         float(summary.get("dem_gap_before", nan)),
         float(summary.get("dem_gap_after", nan)),
         float(summary.get("held_out_dem_gap_before", nan)),
         float(summary.get("held_out_dem_gap_after", nan)),
+        int(n),
+        float(summary["alpha"]),
     )
 
 
@@ -360,17 +374,19 @@ def matrix_scores(rows: pd.DataFrame) -> dict[str, Any]:
 
 
 def _confirmation_line(rows: pd.DataFrame) -> str:
-    """How often the DEM check confirmed right and wrong namings of catalogue effects."""
-    if "dem_confirmed" not in rows:
+    """The DEM check's verdicts on right and wrong namings of catalogue effects."""
+    if "dem_verdict" not in rows:
         return "-"
-    named = rows[(rows["kind"] == "catalogue") & rows["dem_confirmed"].notna()]
+    named = rows[(rows["kind"] == "catalogue") & rows["dem_verdict"].notna()]
     right = named[named["correct"].astype(bool)]
     wrong = named[~named["correct"].astype(bool)]
 
     def count(part: pd.DataFrame) -> str:
-        return f"{int(part['dem_confirmed'].astype(bool).sum())} of {len(part)}"
+        verdicts = part["dem_verdict"].value_counts()
+        found = ", ".join(f"{int(verdicts[v])} {v}" for v in verdicts.index)
+        return f"{len(part)} ({found})" if len(part) else "0"
 
-    return f"{count(right)} right namings, {count(wrong)} wrong ones"
+    return f"right namings {count(right)}; wrong namings {count(wrong)}"
 
 
 def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
@@ -393,8 +409,8 @@ def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
         f"{scores['null_studies']} (goal at most 5 %).",
         f"- Effect outside the catalogue: {pct(scores['outside_acceptable'])} of "
         f"{scores['outside_studies']} acceptable (nothing missing, not explained, or a proxy "
-        "that the DEM runs do not confirm).",
-        f"- Named effects the DEM runs confirmed: {_confirmation_line(rows)}.",
+        "that the DEM runs do not confirm or that leaves a DEM gap above the noise).",
+        f"- DEM verdicts on named catalogue effects: {_confirmation_line(rows)}.",
         "",
         "Confusion matrix (studies per hidden effect and outcome):",
         "",

@@ -8,7 +8,14 @@ import pandas as pd
 import pytest
 import yaml
 
-from demcal.discrepancy.before_after import dem_confirms
+from demcal.discrepancy.effect_verdict import (
+    CONFIRMED,
+    GAP_REMAINS,
+    NOT_CONFIRMED,
+    dem_confirms,
+    dem_noise_bound,
+    effect_verdict,
+)
 from demcal.discrepancy.validation_matrix import (
     AMBIGUOUS,
     GAP_COLUMNS,
@@ -65,6 +72,8 @@ def test_outcomes_are_read_from_the_study(tmp_path):
         "dem_gap_after": 1.1,
         "held_out_dem_gap_before": 2.5,
         "held_out_dem_gap_after": 0.9,
+        "alpha": 0.05,
+        "dem_values": 9,
     }
     write_study(tmp_path / "a", named, truth, {"p_effect": 0.01, "p_runner_up": 0.02})
     row = study_outcome(cohesion, tmp_path / "a")
@@ -74,12 +83,30 @@ def test_outcomes_are_read_from_the_study(tmp_path):
     # The same answer for a material that hides nothing is a false alarm.
     assert study_outcome(none, tmp_path / "a")["correct"] is False
     # A proxy for an effect outside the catalogue is acceptable only if the DEM runs do not
-    # confirm it: here they do (DEM gap 2.9 -> 1.1, held out 2.5 -> 0.9).
-    assert row["dem_confirmed"] is True
+    # confirm it: here they do (DEM gap 2.9 -> 1.1, below 1.37 at 9 values; held out
+    # 2.5 -> 0.9).
+    assert row["dem_verdict"] == CONFIRMED
     assert study_outcome(softer, tmp_path / "a")["correct"] is False
     write_study(tmp_path / "f", {**named, "held_out_dem_gap_after": 3.0}, truth, {})
     proxy = study_outcome(softer, tmp_path / "f")
-    assert (proxy["dem_confirmed"], proxy["correct"]) == (False, True)
+    assert (proxy["dem_verdict"], proxy["correct"]) == (NOT_CONFIRMED, True)
+    # Closer and right at the held-out load, but a DEM gap above the noise is left: the proxy
+    # does not explain the data.
+    write_study(tmp_path / "g", {**named, "dem_gap_after": 1.8}, truth, {})
+    proxy = study_outcome(softer, tmp_path / "g")
+    assert (proxy["dem_verdict"], proxy["correct"]) == (GAP_REMAINS, True)
+    # The bound falls with the number of values: a gap of 1.35 is noise over 9 values (bound
+    # 1.371) and not over 12 (1.324). A summary without the count (studies scored before it
+    # was written) is counted from its before/after table: 12 fitted values there.
+    write_study(tmp_path / "h", {**named, "dem_gap_after": 1.35}, truth, {})
+    assert study_outcome(softer, tmp_path / "h")["dem_verdict"] == CONFIRMED
+    legacy = {k: v for k, v in named.items() if k != "dem_values"}
+    write_study(tmp_path / "i", {**legacy, "dem_gap_after": 1.35}, truth, {})
+    table = pd.DataFrame(
+        {"held_out": [False] * 12 + [True] * 3, "z_dem_after": [1.35] * 12 + [0.5] * 3}
+    )
+    table.to_csv(tmp_path / "i" / "results" / "discrepancy" / "gap_before_after.csv")
+    assert study_outcome(softer, tmp_path / "i")["dem_verdict"] == GAP_REMAINS
     write_study(
         tmp_path / "b",
         {**named, "winner": None, "magnitude": None},
@@ -168,15 +195,21 @@ def test_confusion_matrix_and_scores():
     )
     for column in (*GAP_COLUMNS, "magnitude_ratio"):
         full[column] = 1.0
-    # DEM check of the named effects: the right cohesion namings and the right rolling one
-    # confirmed, the wrong rolling naming of a cohesion study not.
-    full["dem_confirmed"] = [True, True, False, True] + [None] * 5 + [None, False]
+    # DEM check of the named effects: of the right cohesion namings one confirmed and one with
+    # a gap left, the right rolling one confirmed, the wrong rolling naming of a cohesion study
+    # not confirmed.
+    full["dem_verdict"] = (
+        [CONFIRMED, GAP_REMAINS, NOT_CONFIRMED, CONFIRMED] + [None] * 5 + [None, GAP_REMAINS]
+    )
     text = matrix_markdown(full, "Matrix", "python scripts/discrepancy_matrix.py")
     assert "Right effect named: 60 % of 5 studies" in text
     assert "False alarms with nothing hidden: 25 % of 4" in text
     assert "| cohesion | 2 | 1 | 0 | 0 | 0 |" in text
     assert "named or one of two the data could not tell apart: 80 %" in text
-    assert "Named effects the DEM runs confirmed: 3 of 3 right namings, 0 of 1 wrong ones" in text
+    assert (
+        "DEM verdicts on named catalogue effects: right namings 3 (2 confirmed, 1 gap remains); "
+        "wrong namings 1 (1 not confirmed)" in text
+    )
 
 
 def test_placeholder_has_every_fitted_and_held_out_load():
@@ -202,3 +235,19 @@ def test_placeholder_has_every_fitted_and_held_out_load():
 )
 def test_dem_check_confirms_an_effect_only_where_it_counts(gaps, confirmed):
     assert dem_confirms(*gaps) is confirmed
+    # With the gap left within the noise (at most 1.371 over 9 values) the verdict follows.
+    assert effect_verdict(*gaps, 9, 0.05) == (CONFIRMED if confirmed else NOT_CONFIRMED)
+
+
+def test_a_gap_left_above_the_noise_is_not_a_confirmation():
+    # chi^2 quantiles: 16.92 at 9 degrees of freedom, 7.81 at 3.
+    assert dem_noise_bound(9, 0.05) == pytest.approx(math.sqrt(16.919 / 9), rel=1e-4)
+    assert dem_noise_bound(3, 0.05) == pytest.approx(math.sqrt(7.8147 / 3), rel=1e-4)
+    assert effect_verdict(2.9, 1.8, 2.7, 0.76, 9, 0.05) == GAP_REMAINS
+    assert effect_verdict(2.9, 1.3, 2.7, 0.76, 9, 0.05) == CONFIRMED
+    # A stricter test (smaller alpha) lets more of the gap pass as noise.
+    assert effect_verdict(2.9, 1.45, 2.7, 0.76, 9, 0.05) == GAP_REMAINS
+    assert effect_verdict(2.9, 1.45, 2.7, 0.76, 9, 0.01) == CONFIRMED
+    assert effect_verdict(2.9, 3.0, 2.7, 0.76, 9, 0.05) == NOT_CONFIRMED
+    with pytest.raises(ValueError, match="n_values"):
+        dem_noise_bound(0, 0.05)
