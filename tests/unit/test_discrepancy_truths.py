@@ -159,16 +159,26 @@ def test_an_outside_effect_switches_the_configuration_per_profile() -> None:
     spec = load_truth_spec(TRUTHS / "hidden_softer.yaml")
     tiny = yaml.safe_load((ROOT / "config" / "tiny.yaml").read_text())
     quick = {**yaml.safe_load((ROOT / "config" / "config.yaml").read_text()), "profile": "quick"}
-    for config, softer in ((tiny, 250.0), (quick, 750.0)):
+    for config in (tiny, quick):
         truth = draw_truth(spec, config, 3)
         assert truth.effect is None and truth.magnitude is None
         runs = truth_config(truth, config)
-        stiff = config["shear_cell"]["youngs_modulus_per_stress"]
-        assert runs["shear_cell"]["youngs_modulus_per_stress"] == softer < stiff / 3
-        # Only the stiffness changes in the shear cell.
-        assert {
-            k: v for k, v in runs["shear_cell"].items() if k != "youngs_modulus_per_stress"
-        } == {k: v for k, v in config["shear_cell"].items() if k != "youngs_modulus_per_stress"}
+        # One fixed modulus, as a real material has, instead of the model's modulus per unit
+        # stress: four times below the model's at the middle stress (2 029 Pa) and below it at
+        # every stress the studies fit (1 068 Pa and up).
+        per_stress = config["shear_cell"]["youngs_modulus_per_stress"]
+        modulus = runs["material"]["youngsModulus"]
+        assert runs["shear_cell"]["youngs_modulus_per_stress"] == 0.0
+        assert 4.0 * modulus == pytest.approx(per_stress * 2029.0, rel=0.05)
+        assert modulus < per_stress * 1068.0
+        # Only the stiffness changes.
+        for section, key in (
+            ("shear_cell", "youngs_modulus_per_stress"),
+            ("material", "youngsModulus"),
+        ):
+            assert {k: v for k, v in runs[section].items() if k != key} == {
+                k: v for k, v in config[section].items() if k != key
+            }
 
 
 def test_shipped_polydispersity_truths_spread_over_the_draw_span() -> None:
