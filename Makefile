@@ -60,7 +60,7 @@ convergence: setup
 # Validation matrix of the discrepancy workflow: hidden effects x drawn truths, data from
 # LIGGGHTS (MATRIX_PROFILE=config/config.yaml for the quick scale; resumable).
 MATRIX_PROFILE ?= config/tiny.yaml
-MATRIX_ARGS ?= --truths 5
+MATRIX_ARGS ?= --truths 10
 discrepancy-matrix: setup
 	source $(VENV)/bin/activate && python scripts/discrepancy_matrix.py --profile $(MATRIX_PROFILE) \
 		--out results/matrix/$(basename $(notdir $(MATRIX_PROFILE))) $(MATRIX_ARGS)
