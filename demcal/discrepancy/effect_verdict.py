@@ -34,8 +34,11 @@ __all__ = [
 
 #: A gap (root mean square of z) at or below this is within the noise.
 NOISE_GAP = 1.0
+#: Verdict: closer, held-out loads as good or better, and the gap left within the noise.
 CONFIRMED = "confirmed"
+#: Verdict: closer and held-out loads as good or better, but a gap above the noise is left.
 GAP_REMAINS = "gap remains"
+#: Verdict: no closer in DEM, or the held-out loads pushed out of the noise.
 NOT_CONFIRMED = "not confirmed"
 
 
