@@ -9,14 +9,17 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 from demcal.core.experiments import Experiment, load_experiment
 from demcal.core.provenance import write_sidecar
 from demcal.discrepancy.candidates import REFERENCE_CASE
 from demcal.discrepancy.dem_check import held_out_experiment, replicate_bases
-from demcal.discrepancy.effect_verdict import dem_noise_bound, effect_verdict
+from demcal.discrepancy.effect_verdict import (
+    dem_noise_bound,
+    effect_verdict,
+    fitted_dem_values,
+)
 from demcal.discrepancy.observations import observation_table
 from demcal.discrepancy.plan import VERIFICATION_CASE
 from demcal.discrepancy.report import (
@@ -124,12 +127,13 @@ def show(
     gap_before = gap_of(fitted["z_before_common"])
     gap_after = gap_of(fitted["z_after_common"])
     dem_after_gap = gap_of(fitted["z_dem_after"])
-    n_dem = int(np.isfinite(fitted["z_dem_after"].to_numpy(dtype=float)).sum())
+    held_after_gap = gap_of(held["z_dem_after"])
+    n_dem = fitted_dem_values(table)
     verdict = effect_verdict(
         summary["dem_gap_before"],
         dem_after_gap,
         summary["held_out_dem_gap_before"],
-        gap_of(held["z_dem_after"]),
+        held_after_gap,
         n_dem,
         summary["alpha"],
     )
@@ -146,7 +150,7 @@ def show(
             "dem_gap_ratio": summary["dem_gap_before"] / dem_after_gap
             if dem_after_gap > 0
             else math.inf,
-            "held_out_dem_gap_after": gap_of(held["z_dem_after"]),
+            "held_out_dem_gap_after": held_after_gap,
             "dem_values": n_dem,
             "dem_gap_bound": dem_noise_bound(n_dem, summary["alpha"]) if n_dem else math.nan,
             "dem_verdict": verdict,

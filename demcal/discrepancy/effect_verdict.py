@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+import pandas as pd
 from scipy.stats import chi2
 
 __all__ = [
@@ -30,6 +32,7 @@ __all__ = [
     "dem_confirms",
     "dem_noise_bound",
     "effect_verdict",
+    "fitted_dem_values",
 ]
 
 #: A gap (root mean square of z) at or below this is within the noise.
@@ -70,6 +73,24 @@ def dem_confirms(
     if math.isfinite(held_out_after):
         return held_out_after <= max(NOISE_GAP, held_out_before)
     return True
+
+
+def fitted_dem_values(table: pd.DataFrame) -> int:
+    """Measured values on the fitted loads that have a DEM mean after the effect was added.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame, shape (n_observations, ...)
+        The Show step's before/after table (``gap_before_after.csv``), with the columns
+        ``held_out`` (bool) and ``z_dem_after`` (-, NaN where no run finished).
+
+    Returns
+    -------
+    int
+        The N of the gap G over the fitted loads.
+    """
+    fitted = table.loc[~table["held_out"].astype(bool), "z_dem_after"]
+    return int(np.isfinite(fitted.to_numpy(dtype=float)).sum())
 
 
 def dem_noise_bound(n_values: int, alpha: float) -> float:

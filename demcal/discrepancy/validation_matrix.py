@@ -26,13 +26,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 import yaml
 
 from demcal.core.config import validate_config
 from demcal.core.snakemake_run import run_snakemake
-from demcal.discrepancy.effect_verdict import CONFIRMED, effect_verdict
+from demcal.discrepancy.effect_verdict import CONFIRMED, effect_verdict, fitted_dem_values
 from demcal.discrepancy.report import markdown_table
 from demcal.discrepancy.synthetic import (
     study_config,
@@ -315,9 +314,7 @@ def _dem_verdict(summary: Mapping[str, Any], out: Path) -> str | None:
         return None
     n = summary.get("dem_values")
     if n is None:
-        table = pd.read_csv(out / "gap_before_after.csv")
-        fitted = table[~table["held_out"].astype(bool)]
-        n = int(np.isfinite(fitted["z_dem_after"].to_numpy(dtype=float)).sum())
+        n = fitted_dem_values(pd.read_csv(out / "gap_before_after.csv"))
     nan = math.nan
     return effect_verdict(
         float(summary.get("dem_gap_before", nan)),
