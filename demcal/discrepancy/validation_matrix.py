@@ -51,6 +51,7 @@ __all__ = [
     "matrix_cases",
     "matrix_markdown",
     "matrix_scores",
+    "pinned_text",
     "placeholder_experiment",
     "prepare_base",
     "run_case",
@@ -88,6 +89,7 @@ REPORT_COLUMNS = (
     *GAP_COLUMNS,
     "magnitude_ratio",
     "dem_verdict",
+    "pinned",
 )
 
 
@@ -261,6 +263,7 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
     else:
         outcome = NOT_EXPLAINED
     verdict = _dem_verdict(summary, out)
+    find = json.loads((out / "find.json").read_text())
     magnitude = summary.get("magnitude")
     truth_magnitude = truth.get("magnitude")
     ratio = math.nan
@@ -288,7 +291,17 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
         "held_out_dem_gap_after": summary.get("held_out_dem_gap_after", nan),
         "magnitude": magnitude if magnitude is not None else nan,
         "magnitude_ratio": ratio,
+        "pinned": pinned_text(find.get("pinned") or {}),
     }
+
+
+def pinned_text(pinned: Mapping[str, str]) -> str:
+    """Find's parameters at a bound of the box, as ``"coefficientFriction lower"`` ("" if none).
+
+    A best fit on the boundary is the current model straining for data it cannot reach; the
+    matrix reports it per study because it is the first sign of an effect the model lacks.
+    """
+    return "; ".join(f"{name} {side}" for name, side in sorted(pinned.items()))
 
 
 def _correct(case: MatrixCase, outcome: str, verdict: str | None) -> bool:
@@ -386,6 +399,18 @@ def _confirmation_line(rows: pd.DataFrame) -> str:
     return f"right namings {count(right)}; wrong namings {count(wrong)}"
 
 
+def _pinned_line(rows: pd.DataFrame) -> str:
+    """Studies whose Find best fit sits on the box boundary, per hidden effect."""
+    if "pinned" not in rows:
+        return "-"
+    pinned = rows["pinned"].fillna("").astype(str) != ""
+    parts = [
+        f"{label} {int(pinned[group.index].sum())} of {len(group)}"
+        for label, group in rows.groupby("hidden", sort=False)
+    ]
+    return "; ".join(parts)
+
+
 def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
     """The matrix report: scores, confusion matrix and one line per study."""
     scores = matrix_scores(rows)
@@ -408,6 +433,7 @@ def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
         f"{scores['outside_studies']} acceptable (nothing missing, not explained, or a proxy "
         "that the DEM runs do not confirm or that leaves a DEM gap above the noise).",
         f"- DEM verdicts on named catalogue effects: {_confirmation_line(rows)}.",
+        f"- Find's best fit on the boundary of the box: {_pinned_line(rows)}.",
         "",
         "Confusion matrix (studies per hidden effect and outcome):",
         "",

@@ -48,10 +48,13 @@ def test_cases_cover_every_spec_with_distinct_seeds():
         matrix_cases(specs, 0, 1)
 
 
-def write_study(work: Path, summary: dict, truth: dict, ranking: dict) -> None:
+def write_study(
+    work: Path, summary: dict, truth: dict, ranking: dict, pinned: dict | None = None
+) -> None:
     out = work / "results" / "discrepancy"
     out.mkdir(parents=True)
     (out / "summary.json").write_text(json.dumps(summary))
+    (out / "find.json").write_text(json.dumps({"pinned": pinned or {}}))
     (out / "ranking.json").write_text(json.dumps(ranking))
     (work / "truth.yaml").write_text(yaml.safe_dump(truth))
 
@@ -77,7 +80,7 @@ def test_outcomes_are_read_from_the_study(tmp_path):
     }
     write_study(tmp_path / "a", named, truth, {"p_effect": 0.01, "p_runner_up": 0.02})
     row = study_outcome(cohesion, tmp_path / "a")
-    assert (row["outcome"], row["correct"]) == ("cohesion", True)
+    assert (row["outcome"], row["correct"], row["pinned"]) == ("cohesion", True, "")
     assert row["magnitude_ratio"] == pytest.approx(0.8)
     assert row["held_out_dem_gap_after"] == 0.9
     # The same answer for a material that hides nothing is a false alarm.
@@ -87,9 +90,16 @@ def test_outcomes_are_read_from_the_study(tmp_path):
     # 2.5 -> 0.9).
     assert row["dem_verdict"] == CONFIRMED
     assert study_outcome(softer, tmp_path / "a")["correct"] is False
-    write_study(tmp_path / "f", {**named, "held_out_dem_gap_after": 3.0}, truth, {})
+    write_study(
+        tmp_path / "f",
+        {**named, "held_out_dem_gap_after": 3.0},
+        truth,
+        {},
+        {"density": "upper", "coefficientFriction": "lower"},
+    )
     proxy = study_outcome(softer, tmp_path / "f")
     assert (proxy["dem_verdict"], proxy["correct"]) == (NOT_CONFIRMED, True)
+    assert proxy["pinned"] == "coefficientFriction lower; density upper"
     # Closer and right at the held-out load, but a DEM gap above the noise is left: the proxy
     # does not explain the data.
     write_study(tmp_path / "g", {**named, "dem_gap_after": 1.8}, truth, {})
@@ -195,6 +205,7 @@ def test_confusion_matrix_and_scores():
     )
     for column in (*GAP_COLUMNS, "magnitude_ratio"):
         full[column] = 1.0
+    full["pinned"] = [""] * 9 + ["coefficientFriction lower"] * 2
     # DEM check of the named effects: of the right cohesion namings one confirmed and one with
     # a gap left, the right rolling one confirmed, the wrong rolling naming of a cohesion study
     # not confirmed.
@@ -209,6 +220,10 @@ def test_confusion_matrix_and_scores():
     assert (
         "DEM verdicts on named catalogue effects: right namings 3 (2 confirmed, 1 gap remains); "
         "wrong namings 1 (1 not confirmed)" in text
+    )
+    assert (
+        "best fit on the boundary of the box: cohesion 0 of 3; rolling 0 of 2; none 0 of 4; "
+        "softer 2 of 2." in text
     )
 
 
