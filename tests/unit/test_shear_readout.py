@@ -260,6 +260,37 @@ def test_interrupted_run_flags_unsteady_and_missing_phases() -> None:
     assert got2["mu_psh"].iloc[1] == pytest.approx(0.5, abs=0.005)
 
 
+@pytest.mark.parametrize("share", [-0.3, 0.2, 2.1])
+def test_a_phase_whose_load_was_lost_gives_no_value(share: float) -> None:
+    # The servo lid of a strongly cohesive bed at low stress: from halfway through the shear
+    # of cycle 0 the lid force sits at `share` x the target (as LIGGGHTS and the engine read
+    # at 1.16e5 J/m^3 and 1 068 Pa: -1.7 to 0.25 and 2.0 to 3.3), while the pre-shear held it.
+    table = synthetic_run(CYCLES, seed=4)
+    shear = table[(table["cycle"] == 0) & (table["phase"] == 3)]
+    lost = shear.index[len(shear) // 2 :]
+    table.loc[lost, "lid_force"] = share * table.loc[lost, "target_force"]
+    got = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
+    assert np.isnan(got["mu_sh"].iloc[0]) and not got["steady_sh"].iloc[0]
+    assert got["sh_reason"].iloc[0].startswith("normal load not held: lid force")
+    # The pre-shear of the same cycle and the whole of cycle 1 are read as before.
+    assert got["mu_psh"].iloc[0] == pytest.approx(CYCLES[0]["mu_psh"], abs=0.005)
+    assert got["rho_b"].iloc[0] == pytest.approx(CYCLES[0]["rho_b"], rel=1e-3)
+    assert got["mu_sh"].iloc[1] == pytest.approx(CYCLES[1]["mu_sh"], abs=0.005)
+
+
+def test_a_lost_pre_shear_load_gives_no_density_either() -> None:
+    table = synthetic_run(CYCLES[:1], seed=5)
+    pre = table["phase"] == 1
+    table.loc[pre, "lid_force"] = 1.6 * table.loc[pre, "target_force"]
+    got = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
+    assert np.isnan(got["mu_psh"].iloc[0]) and np.isnan(got["rho_b"].iloc[0])
+    assert "1.60 x the target" in got["psh_reason"].iloc[0]
+    # Within the band (the tiny cell's sound runs reach 1.35) the value stands.
+    table.loc[pre, "lid_force"] = 1.4 * table.loc[pre, "target_force"]
+    kept = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G)
+    assert np.isfinite(kept["mu_psh"].iloc[0]) and np.isfinite(kept["rho_b"].iloc[0])
+
+
 def test_from_print_file(tmp_path: Path) -> None:
     table = synthetic_run(CYCLES, seed=4)[["step", *REQUIRED_COLUMNS]]
     path = tmp_path / "shear.print"

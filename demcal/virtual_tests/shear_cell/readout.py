@@ -54,6 +54,13 @@ cycle;
 ``rho_b`` is averaged over the pre-shear plateau. ``P`` is the ratio of the servo target forces
 of shear and pre-shear, and ``normal_stress`` the pre-shear target force over ``pi R^2``.
 
+A phase whose servo did not hold the load gives no value: when the lid force averaged over the
+plateau lies outside :data:`LOAD_HELD` times the target force, ``mu`` (and for a pre-shear
+``rho_b``) is NaN, the phase is not steady and its reason says so. With a strongly cohesive bed
+at low stress the lid's force jumps to zero, below it or to several times the target, and the
+lid stops following, in the bundled engine and in LIGGGHTS alike; the readings of such a phase
+(a mu_psh of -2 or of 3) describe the controller, not the material.
+
 A ring deck run with ``shear_cell.bulk_density: interior`` also prints ``interior_mass`` (kg),
 the mass of the particles whose centres lie in an annulus clear of the walls and bars; then
 ``rho_b`` is that mass over the annulus' volume, averaged over the same plateau, and the whole
@@ -63,6 +70,8 @@ for a region away from walls, where the packing is the same everywhere on averag
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from typing import Any
 
 import numpy as np
@@ -74,6 +83,7 @@ from demcal.engine_io.output_errors import require_columns
 
 __all__ = [
     "INTERIOR_MASS_COLUMN",
+    "LOAD_HELD",
     "PHASE_PRE_SHEAR",
     "PHASE_SETTLE",
     "PHASE_SHEAR",
@@ -122,6 +132,11 @@ RING_COLUMNS: tuple[str, ...] = (
 INTERIOR_MASS_COLUMN = "interior_mass"
 
 _SOURCE = "shear-cell table"
+
+#: Band of the plateau-mean lid force over the target force within which a phase held its
+#: normal load. Sound runs stay within 0.87-1.35 (tiny cell, strong rolling resistance) and
+#: 0.93-1.08 (quick cell); runs whose servo lost the load read -1.7 to 0.25 or 2.0 to 3.3.
+LOAD_HELD = (0.5, 1.5)
 
 
 def _cross_section(radius: float, inner_radius: float | None) -> float:
@@ -295,6 +310,26 @@ def _phase_plateau(rows: pd.DataFrame, plateau_kwargs: dict[str, Any]) -> Platea
     return detect_plateau(t, rows["mu"].to_numpy(dtype=np.float64), **plateau_kwargs)
 
 
+def _load_checked(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None:
+    """The plateau, or a NaN one when the lid force over it left :data:`LOAD_HELD` x target."""
+    if plateau is None or not np.isfinite(plateau.mean):
+        return plateau
+    rows = rows.drop_duplicates(subset="time", keep="last")
+    window = rows.iloc[plateau.start_index : plateau.end_index]
+    target = float(window["target_force"].median())
+    ratio = float(window["lid_force"].mean()) / target if target > 0.0 else math.nan
+    low, high = LOAD_HELD
+    if low <= ratio <= high:
+        return plateau
+    return dataclasses.replace(
+        plateau,
+        mean=math.nan,
+        sem=math.nan,
+        steady=False,
+        reason=f"normal load not held: lid force {ratio:.2f} x the target over the plateau",
+    )
+
+
 def shear_cell_bulk_values(
     table: pd.DataFrame,
     radius: float,
@@ -369,8 +404,8 @@ def shear_cell_bulk_values(
         in_cycle = series["cycle"] == cycle
         pre = series[in_cycle & (series["phase"] == PHASE_PRE_SHEAR)]
         shear = series[in_cycle & (series["phase"] == PHASE_SHEAR)]
-        p_psh = _phase_plateau(pre, plateau_kwargs)
-        p_sh = _phase_plateau(shear, plateau_kwargs)
+        p_psh = _load_checked(pre, _phase_plateau(pre, plateau_kwargs))
+        p_sh = _load_checked(shear, _phase_plateau(shear, plateau_kwargs))
 
         target_pre = float(pre["target_force"].median()) if not pre.empty else np.nan
         target_sh = float(shear["target_force"].median()) if not shear.empty else np.nan
@@ -380,7 +415,7 @@ def shear_cell_bulk_values(
                 f"(cycle {int(cycle)}, median {target_pre})"
             )
         rho_b = rho_b_cell = np.nan
-        if p_psh is not None:
+        if p_psh is not None and np.isfinite(p_psh.mean):
             rows = pre.drop_duplicates(subset="time", keep="last")
             plateau = rows.iloc[p_psh.start_index : p_psh.end_index]
             rho_b = rho_b_cell = float(plateau["rho_b"].mean())
