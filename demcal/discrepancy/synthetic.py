@@ -314,16 +314,24 @@ def replicate_record(
     if p_values is not None:
         shear = shear[shear["P"].round(6).isin([round(float(p), 6) for p in p_values])]
     conditions = []
+    # Runs without a value (a phase that lost its load, no plateau) are left out of the mean,
+    # as a laboratory discards a failed test, and the source says where.
+    short = []
     for (stress, p), rows in shear.groupby(["normal_stress", "P"], sort=True):
         entry: dict[str, float] = {"normal_stress": float(stress), "P": float(p)}
         for name in observables:
-            if rows[name].notna().any():
+            valid = int(rows[name].notna().sum())
+            if valid < len(rows):
+                short.append(f"{name} at {stress:g} Pa, P {p:g}: {valid} of {len(rows)}")
+            if valid:
                 value, sd = measured(rows[name], name)
                 entry[name] = round(value, 6)
                 entry[f"{name}_sd"] = round(sd, 6)
         conditions.append(entry)
     if conditions:
         record["shear_cell"] = conditions
+    if short:
+        record["source"] = f"{source}; runs with a value: {'; '.join(short)}"
     return record
 
 

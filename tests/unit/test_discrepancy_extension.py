@@ -244,6 +244,8 @@ def test_replicate_record_states_mean_and_scatter():
     assert entry["mu_psh"] == pytest.approx(0.6) and entry["mu_psh_sd"] == pytest.approx(se)
     assert entry["mu_sh_sd"] == 0.0
     assert entry["rho_b"] == pytest.approx(1705.0)
+    # The run without a density is left out of the mean, and the source says so.
+    assert record["source"] == "test; runs with a value: rho_b at 1068 Pa, P 0.5: 2 of 3"
     noisy = replicate_record(bulk, "m", {"mu_psh": 0.01, "rho_b": 0.02}, 1, "test")
     noisy = noisy["shear_cell"][0]
     # The sd also covers the added noise: sqrt(se^2 + (0.01 * 0.6)^2).
@@ -274,5 +276,6 @@ def test_replicate_record_keeps_the_readings_and_loads_asked_for():
         (2029.0, 1.0),
     ]
     assert [c["mu_psh"] for c in record["shear_cell"]] == [0.6, 0.58]
+    assert record["source"] == "t"
     assert all("mu_sh" not in c for c in record["shear_cell"])
     assert record["angle_of_repose"]["value"] == 31.0
