@@ -13,6 +13,9 @@ are found:
 - ``probe_clearance``: a drawn magnitude closer than this fraction of the range to a probe level
   is drawn again (default :data:`PROBE_CLEARANCE`), so no truth sits at a level the workflow
   measures directly;
+- ``off_clearance``: likewise for the candidate's "absent" value (default
+  :data:`OFF_CLEARANCE`), which for wall friction is the truth's own sliding friction: a hidden
+  effect has to be there to be found;
 - ``switch``: configuration overrides of the truth runs beyond the hidden candidate (an
   effect outside the catalogue, e.g. softer particles);
 - ``profiles``: per profile, replacements of ``parameters``, ``draw`` and ``switch``.
@@ -43,6 +46,7 @@ from demcal.discrepancy.candidates import (
 __all__ = [
     "EFFECT_SPAN",
     "MAX_EFFECT_FRACTION",
+    "OFF_CLEARANCE",
     "PROBE_CLEARANCE",
     "DrawnTruth",
     "draw_truth",
@@ -56,6 +60,10 @@ EFFECT_SPAN = (0.15, 0.7)
 MAX_EFFECT_FRACTION = 0.8
 #: Default smallest distance of a drawn magnitude from any probe level (fraction of the range).
 PROBE_CLEARANCE = 0.05
+#: Default smallest distance of a drawn magnitude from the candidate's "absent" value (fraction
+#: of the range). Equal to the lower end of EFFECT_SPAN, so that it only acts where the absent
+#: value lies inside the range (wall friction: the sliding friction).
+OFF_CLEARANCE = 0.15
 _MAX_DRAWS = 1000
 
 
@@ -116,7 +124,7 @@ def load_truth_spec(path: str | Path) -> dict[str, Any]:
 def _profile_spec(spec: Mapping[str, Any], profile: str) -> dict[str, Any]:
     overrides = (spec.get("profiles") or {}).get(profile) or {}
     out = dict(spec)
-    for key in ("parameters", "draw", "switch", "effect_span", "probe_clearance"):
+    for key in ("parameters", "draw", "switch", "effect_span", "probe_clearance", "off_clearance"):
         if key in overrides:
             out[key] = (
                 {**(spec.get(key) or {}), **overrides[key]}
@@ -143,7 +151,10 @@ def _draw_magnitude(
     clearance: float,
     rng: np.random.Generator,
     where: str,
+    off: tuple[float, float] = (math.nan, 0.0),
 ) -> float:
+    """A magnitude from ``span`` of the candidate's range, clear of its probe levels and of
+    ``off`` = (absent value, clearance as a fraction of the range)."""
     lo, hi = candidate.range
     width = hi - lo
     a, b = span
@@ -154,12 +165,15 @@ def _draw_magnitude(
         )
     low, high = lo + a * width, lo + b * width
     levels = np.asarray(candidate.probe_levels, float)
+    off_value, off_clearance = off
+
+    def clear(value: float) -> bool:
+        # NaN (no absent value inside the range) compares False: nothing to keep clear of.
+        near_off = abs(value - off_value) <= off_clearance * width
+        return bool(np.all(np.abs(levels - value) > clearance * width)) and not near_off
+
     if candidate.integer:
-        options = [
-            v
-            for v in range(math.ceil(low), math.floor(high) + 1)
-            if np.all(np.abs(levels - v) > clearance * width)
-        ]
+        options = [v for v in range(math.ceil(low), math.floor(high) + 1) if clear(v)]
         if not options:
             raise ValueError(
                 f"{where}: no whole magnitude of {candidate.name} in [{low:g}, {high:g}] keeps "
@@ -168,11 +182,12 @@ def _draw_magnitude(
         return float(options[int(rng.integers(len(options)))])
     for _ in range(_MAX_DRAWS):
         value = float(rng.uniform(low, high))
-        if np.all(np.abs(levels - value) > clearance * width):
+        if clear(value):
             return value
     raise ValueError(
-        f"{where}: the probe levels {list(candidate.probe_levels)} leave no room in "
-        f"[{low:g}, {high:g}] at a clearance of {clearance:g} of the range"
+        f"{where}: the probe levels {list(candidate.probe_levels)} and the absent value "
+        f"{off_value:g} leave no room in [{low:g}, {high:g}] at clearances of {clearance:g} "
+        f"and {off_clearance:g} of the range"
     )
 
 
@@ -223,7 +238,11 @@ def draw_truth(
         candidate = _candidate(config, str(effect), where)
         span = tuple(float(v) for v in spec.get("effect_span", EFFECT_SPAN))
         clearance = float(spec.get("probe_clearance", PROBE_CLEARANCE))
-        magnitude = _draw_magnitude(candidate, (span[0], span[1]), clearance, rng, where)
+        off = (
+            candidate.off_magnitude(parameters),
+            float(spec.get("off_clearance", OFF_CLEARANCE)),
+        )
+        magnitude = _draw_magnitude(candidate, (span[0], span[1]), clearance, rng, where, off)
         drawn[candidate.parameter] = magnitude
         if not candidate.config_key:
             parameters[candidate.parameter] = magnitude

@@ -202,3 +202,31 @@ def test_shipped_polydispersity_truths_spread_over_the_draw_span() -> None:
         assert particles["classes"] == truth.magnitude
         dist = size_distribution(particles)
         assert dist.n_classes == math.ceil(truth.magnitude) > truth.magnitude
+
+
+def test_a_hidden_wall_friction_keeps_clear_of_the_sliding_friction() -> None:
+    # The absent value of wall friction is the truth's own sliding friction: a wall friction
+    # drawn next to it hides nothing. Seed 101 drew 0.62 against 0.72 before the clearance.
+    spec = load_truth_spec(TRUTHS / "hidden_wallfriction.yaml")
+    config = {**yaml.safe_load((ROOT / "config" / "config.yaml").read_text()), "profile": "quick"}
+    (low, high) = next(
+        c["range"] for c in config["discrepancy"]["candidates"] if c["name"] == "wallfriction"
+    )
+    gaps, magnitudes = [], []
+    for seed in range(101, 161):
+        truth = draw_truth(spec, config, seed)
+        gaps.append(abs(truth.magnitude - truth.parameters["coefficientFriction"]))
+        magnitudes.append(truth.magnitude)
+    assert min(gaps) > 0.15 * (high - low)
+    # Still drawn over the span, on both sides of the sliding friction.
+    assert min(magnitudes) < 0.3 and max(magnitudes) > 0.65
+    first = draw_truth(spec, config, 101)
+    assert first.parameters["coefficientFriction"] == pytest.approx(0.7218, abs=1e-4)
+    assert abs(first.magnitude - 0.7218) > 0.135
+    # Where the absent value lies at the range's end (cohesion: 0) the same seeds draw the same
+    # truths as without the clearance: the span already starts 15 % of the range above it.
+    cohesion = load_truth_spec(TRUTHS / "hidden_cohesion.yaml")
+    for seed in range(101, 121):
+        assert draw_truth(cohesion, config, seed) == draw_truth(
+            {**cohesion, "off_clearance": 0.0}, config, seed
+        )
