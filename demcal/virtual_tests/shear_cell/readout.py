@@ -297,12 +297,17 @@ def shear_stress_series(
     return out
 
 
+def _unique_steps(rows: pd.DataFrame) -> pd.DataFrame:
+    """The rows of one phase without repeats: a step printed twice at a run boundary carries
+    no new information. Plateau indices count these rows."""
+    return rows.drop_duplicates(subset="time", keep="last")
+
+
 def _phase_plateau(rows: pd.DataFrame, plateau_kwargs: dict[str, Any]) -> Plateau | None:
-    """Plateau of mu over the rows of one phase, or None if the phase is absent."""
+    """Plateau of mu over the rows of one phase (:func:`_unique_steps`), or None if the phase
+    is absent."""
     if rows.empty:
         return None
-    # A step printed twice at a run boundary carries no new information.
-    rows = rows.drop_duplicates(subset="time", keep="last")
     t = rows["time"].to_numpy(dtype=np.float64)
     if np.any(np.diff(t) <= 0.0):
         row = int(rows.index[int(np.flatnonzero(np.diff(t) <= 0.0)[0]) + 1])
@@ -311,10 +316,10 @@ def _phase_plateau(rows: pd.DataFrame, plateau_kwargs: dict[str, Any]) -> Platea
 
 
 def _load_checked(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None:
-    """The plateau, or a NaN one when the lid force over it left :data:`LOAD_HELD` x target."""
+    """The plateau, or a NaN one when the lid force over it left :data:`LOAD_HELD` x target
+    (``rows`` as given to :func:`_phase_plateau`)."""
     if plateau is None or not np.isfinite(plateau.mean):
         return plateau
-    rows = rows.drop_duplicates(subset="time", keep="last")
     window = rows.iloc[plateau.start_index : plateau.end_index]
     target = float(window["target_force"].median())
     ratio = float(window["lid_force"].mean()) / target if target > 0.0 else math.nan
@@ -404,8 +409,9 @@ def shear_cell_bulk_values(
         in_cycle = series["cycle"] == cycle
         pre = series[in_cycle & (series["phase"] == PHASE_PRE_SHEAR)]
         shear = series[in_cycle & (series["phase"] == PHASE_SHEAR)]
-        p_psh = _load_checked(pre, _phase_plateau(pre, plateau_kwargs))
-        p_sh = _load_checked(shear, _phase_plateau(shear, plateau_kwargs))
+        pre_steps, shear_steps = _unique_steps(pre), _unique_steps(shear)
+        p_psh = _load_checked(pre_steps, _phase_plateau(pre_steps, plateau_kwargs))
+        p_sh = _load_checked(shear_steps, _phase_plateau(shear_steps, plateau_kwargs))
 
         target_pre = float(pre["target_force"].median()) if not pre.empty else np.nan
         target_sh = float(shear["target_force"].median()) if not shear.empty else np.nan
@@ -416,8 +422,7 @@ def shear_cell_bulk_values(
             )
         rho_b = rho_b_cell = np.nan
         if p_psh is not None and np.isfinite(p_psh.mean):
-            rows = pre.drop_duplicates(subset="time", keep="last")
-            plateau = rows.iloc[p_psh.start_index : p_psh.end_index]
+            plateau = pre_steps.iloc[p_psh.start_index : p_psh.end_index]
             rho_b = rho_b_cell = float(plateau["rho_b"].mean())
             if interior_volume is not None:
                 rho_b = float(plateau["rho_b_interior"].mean())
