@@ -34,6 +34,7 @@ from demcal.discrepancy.observations import SurrogateModel
 from demcal.discrepancy.ranking import (
     NamingTest,
     fit_candidate,
+    naming_power,
     naming_test,
     null_fit,
     rank_candidates,
@@ -42,7 +43,10 @@ from demcal.discrepancy.ranking import (
 from demcal.discrepancy.report import condition_label, ranking_markdown
 from demcal.discrepancy.run_results import read_runs, replicate_statistics
 
-__all__ = ["RankingResult", "rank", "ranking_record", "write_ranking"]
+__all__ = ["UNNAMEABLE", "RankingResult", "rank", "ranking_record", "write_ranking"]
+
+#: Naming power below which a candidate counts as not nameable from the measurements.
+UNNAMEABLE = 0.5
 
 
 @dataclass
@@ -68,6 +72,10 @@ class RankingResult:
     ambiguous : tuple of str or None
         The top candidate and the runner-up when an effect was found but the two could not be
         told apart (nothing named for that reason), else None.
+    power : DataFrame or None
+        Per candidate and probe level, the shares of data sets with that effect in which it
+        would be found and named (:func:`~demcal.discrepancy.ranking.naming_power`); None
+        when no candidate was scored or ``discrepancy.power_draws`` is 0.
     """
 
     table: pd.DataFrame
@@ -78,6 +86,7 @@ class RankingResult:
     notes: list[str] = field(default_factory=list)
     test: NamingTest | None = None
     ambiguous: tuple[str, str] | None = None
+    power: pd.DataFrame | None = None
 
 
 def rank(
@@ -204,6 +213,19 @@ def rank(
             int(settings["magnitude_points"]),
             int(settings["bootstrap_draws"]),
         )
+    power = None
+    if responses and int(settings["power_draws"]) > 0:
+        power = naming_power(
+            predictions,
+            obs["measured"].to_numpy(float),
+            weights,
+            responses,
+            float(settings["alpha"]),
+            int(settings["magnitude_points"]),
+            int(settings["power_draws"]),
+            int(settings["bootstrap_draws"]),
+        )
+        notes += _power_notes(power)
     ambiguous = None
     if winner_name is not None and test is not None:
         winner_name, ambiguous = _tested_winner(
@@ -223,8 +245,36 @@ def rank(
     table.loc[table["status"] == "scored", "status"] = np.where(
         table.loc[table["status"] == "scored", "named"], "named", "not significant"
     )
+    if power is not None:
+        table["power"] = table["candidate"].map(_power_text(power))
     winner = next((c for c in candidates if c.name == winner_name), None)
-    return RankingResult(table, winner, fits, null, null_weighted.deviance, notes, test, ambiguous)
+    return RankingResult(
+        table, winner, fits, null, null_weighted.deviance, notes, test, ambiguous, power
+    )
+
+
+def _power_text(power: pd.DataFrame) -> dict[str, str]:
+    """Candidate -> its naming power per probe level, e.g. ``"1.5e+04: 8 %, 6.5e+04: 97 %"``."""
+    return {
+        name: ", ".join(f"{r.magnitude:.3g}: {100 * r.named:.0f} %" for r in rows.itertuples())
+        for name, rows in power.groupby("candidate", sort=False)
+    }
+
+
+def _power_notes(power: pd.DataFrame) -> list[str]:
+    """A note for each candidate that these measurements could not name at any probe level."""
+    notes = []
+    for name, rows in power.groupby("candidate", sort=False):
+        best = rows.loc[rows["named"].idxmax()]
+        if best["named"] < UNNAMEABLE:
+            notes.append(
+                f"{name} could not be named from these measurements even if it were present "
+                f"at its probe level {best['magnitude']:.3g}: data sets drawn with it there "
+                f"show an effect in {100 * best['found']:.0f} % and name it in at most "
+                f"{100 * best['named']:.0f} % - what it changes, the fitted parameters absorb "
+                "or the noise hides; a 'nothing missing' or another name does not rule it out"
+            )
+    return notes
 
 
 def _mean_of_runs(runs: pd.DataFrame, run: str, count: int, obs: pd.DataFrame) -> np.ndarray:
@@ -276,6 +326,12 @@ def ranking_record(result: RankingResult) -> dict[str, Any]:
         "ambiguous": list(result.ambiguous) if result.ambiguous else None,
         "runner_up": result.test.runner_up if result.test else None,
         "p_runner_up": result.test.p_runner_up if result.test else None,
+        "power": []
+        if result.power is None
+        else [
+            {k: (str(v) if k == "candidate" else float(v)) for k, v in row.items()}
+            for row in result.power.to_dict("records")
+        ],
         "ranking": [
             {
                 "candidate": r.candidate,

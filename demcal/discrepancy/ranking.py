@@ -42,6 +42,13 @@ parametric-bootstrap tests whose error rates are known at the few values a shear
 A candidate is named only when both p-values are below alpha, it removes at least a given share
 of D_0, and every applicable candidate could be scored (otherwise the best of the scored ones
 need not be the right one).
+
+Whether the measurements could name a candidate at all is a separate question, answered before
+anyone reads a "nothing named" as "not there" (:func:`naming_power`): data sets drawn with the
+candidate present at each of its probe levels go through the effect test, and the share in which
+it is found and leads bounds its naming probability. A candidate whose response the current
+parameters absorb (a denser packing that a higher particle density reproduces) or that stays
+within the noise cannot be named from these data, however the decision rule is tuned.
 """
 
 from __future__ import annotations
@@ -61,6 +68,7 @@ __all__ = [
     "CandidateFit",
     "NamingTest",
     "fit_candidate",
+    "naming_power",
     "naming_test",
     "null_fit",
     "rank_candidates",
@@ -302,6 +310,16 @@ def _best(
     return out
 
 
+def _largest_drops(
+    grid: np.ndarray, offsets: list[list[np.ndarray]], data: np.ndarray, weights: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per data set (rows of ``data``, shape (B, K)), the largest deviance drop D_0 - D_c over
+    the candidates (their offsets in order) and the index of the candidate giving it."""
+    d0 = best_deviances(grid, data, weights)
+    per_candidate = np.array([d0 - _best(grid, o, data, weights) for o in offsets])
+    return per_candidate.max(axis=0), per_candidate.argmax(axis=0)
+
+
 def _best_row(
     grid: np.ndarray, offsets: list[np.ndarray], y: np.ndarray, weights: np.ndarray
 ) -> np.ndarray:
@@ -356,10 +374,7 @@ def naming_test(
     # Is there an effect: the largest drop over all candidates, under "nothing missing".
     null_point = _best_row(grid_predictions, [np.zeros_like(y)], y, w)
     data = null_point + w * rng.standard_normal((draws, y.size))
-    null_d0 = best_deviances(grid_predictions, data, w)
-    drops = np.max(
-        [null_d0 - _best(grid_predictions, o, data, w) for o in offsets.values()], axis=0
-    )
+    drops, _ = _largest_drops(grid_predictions, list(offsets.values()), data, w)
     p_effect = float((1 + np.count_nonzero(drops >= d0 - dc[top])) / (draws + 1))
     if len(order) < 2:
         return NamingTest(top, p_effect, None, None, None, draws)
@@ -374,3 +389,85 @@ def naming_test(
     p_second = float((1 + np.count_nonzero(gaps >= dc[second] - dc[top])) / (draws + 1))
     separating = int(np.argmax(np.abs(top_point - second_point) / w))
     return NamingTest(top, p_effect, second, p_second, separating, draws)
+
+
+def naming_power(
+    grid_predictions: np.ndarray,
+    y: np.ndarray,
+    weights: np.ndarray,
+    responses: Mapping[str, EffectResponse],
+    alpha: float,
+    magnitude_points: int = 41,
+    draws: int = 200,
+    null_draws: int = 1000,
+    seed: int = 1,
+) -> pd.DataFrame:
+    """How often each candidate would be found and lead if it were present at a probe level.
+
+    Data sets are drawn as the current model's best fit to ``y`` (as in :func:`naming_test`)
+    plus the candidate's response at one of its probe levels plus noise with the ranking
+    weights, and put through the effect test of :func:`naming_test` (``null_draws`` data sets
+    under "nothing missing" give the critical drop). ``found`` is the share in which the test
+    rejects "nothing missing" at ``alpha``; ``named`` the share in which it also leads the
+    candidates. ``named`` bounds the naming probability from above (the runner-up test is not
+    repeated per data set), so a low value means these measurements cannot name the candidate
+    at that magnitude: what it changes, the current parameters absorb or the noise hides. The
+    responses carry the probe runs' noise, which makes the shares, if anything, too high.
+
+    Parameters
+    ----------
+    grid_predictions : ndarray, shape (G, K)
+        The current model's predictions over the parameter grid.
+    y : ndarray, shape (K,)
+        Measured values.
+    weights : ndarray, shape (K,)
+        Ranking weights (:func:`ranking_sigma`).
+    responses : mapping
+        Candidate name -> DEM response; at least one.
+    alpha : float
+        Significance level of the effect test.
+    magnitude_points : int
+        Magnitudes tried per continuous candidate, as in :func:`fit_candidate`.
+    draws : int
+        Data sets per candidate and probe level.
+    null_draws : int
+        Data sets under "nothing missing" for the critical drop.
+    seed : int
+        Seed of the draws.
+
+    Returns
+    -------
+    DataFrame
+        One row per candidate and probe level (the effect-off reference excluded): candidate,
+        magnitude, found, named (shares in [0, 1]).
+    """
+    if not responses:
+        raise ValueError("naming_power needs at least one candidate")
+    rng = np.random.default_rng(seed)
+    w = np.asarray(weights, float)
+    y = np.asarray(y, float)
+    names = list(responses)
+    offsets = [_offsets(responses[c], magnitude_points) for c in names]
+    base = _best_row(grid_predictions, [np.zeros_like(y)], y, w)
+    null = base + w * rng.standard_normal((null_draws, y.size))
+    null_drops = np.sort(_largest_drops(grid_predictions, offsets, null, w)[0])
+    rows = []
+    for i, name in enumerate(names):
+        response = responses[name]
+        for j, level in enumerate(response.magnitudes):
+            if j == response.reference:
+                continue
+            data = base + response.responses[j] + w * rng.standard_normal((draws, y.size))
+            drops, leader = _largest_drops(grid_predictions, offsets, data, w)
+            # p = (1 + #{null drops >= drop}) / (null_draws + 1), as for p_effect.
+            exceed = null_drops.size - np.searchsorted(null_drops, drops, side="left")
+            found = (1 + exceed) / (null_drops.size + 1) < alpha
+            rows.append(
+                {
+                    "candidate": name,
+                    "magnitude": float(level),
+                    "found": float(found.mean()),
+                    "named": float((found & (leader == i)).mean()),
+                }
+            )
+    return pd.DataFrame(rows, columns=["candidate", "magnitude", "found", "named"])

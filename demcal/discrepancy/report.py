@@ -148,11 +148,20 @@ def ranking_markdown(
             "explained",
             "gap",
             "status",
+            "power",
             "signature",
         )
         if c in shown
     ]
     lines.append(markdown_table(shown[columns], ".3g"))
+    if "power" in shown:
+        lines += [
+            "power: per probe level, the share of data sets drawn with the candidate present at "
+            "that level (the current model's best fit plus its response plus noise) in which "
+            "the effect test rejects 'nothing missing' and the candidate leads - an upper bound "
+            "on how often these measurements would name it. Below 50 % at every level they "
+            "cannot name it, and not naming it says nothing about its presence.",
+        ]
     descriptions = table[["candidate", "description"]].drop_duplicates()
     lines += ["", "Candidates:", ""]
     lines += [f"- {r.candidate}: {r.description}" for r in descriptions.itertuples()]

@@ -26,12 +26,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 import yaml
 
 from demcal.core.config import validate_config
 from demcal.core.snakemake_run import run_snakemake
 from demcal.discrepancy.effect_verdict import CONFIRMED, effect_verdict, fitted_dem_values
+from demcal.discrepancy.probe_ranking import UNNAMEABLE
 from demcal.discrepancy.report import markdown_table
 from demcal.discrepancy.synthetic import (
     study_config,
@@ -53,6 +55,7 @@ __all__ = [
     "matrix_scores",
     "pinned_text",
     "placeholder_experiment",
+    "power_at",
     "prepare_base",
     "run_case",
     "study_outcome",
@@ -88,6 +91,7 @@ REPORT_COLUMNS = (
     "p_runner_up",
     *GAP_COLUMNS,
     "magnitude_ratio",
+    "power_at_truth",
     "dem_verdict",
     "pinned",
 )
@@ -291,8 +295,28 @@ def study_outcome(case: MatrixCase, work: str | Path) -> dict[str, Any]:
         "held_out_dem_gap_after": summary.get("held_out_dem_gap_after", nan),
         "magnitude": magnitude if magnitude is not None else nan,
         "magnitude_ratio": ratio,
+        "power_at_truth": (
+            power_at(ranking.get("power") or [], case.hidden, float(truth_magnitude))
+            if case.kind == "catalogue" and truth_magnitude is not None
+            else nan
+        ),
         "pinned": pinned_text(find.get("pinned") or {}),
     }
+
+
+def power_at(power: Sequence[Mapping[str, Any]], candidate: str, magnitude: float) -> float:
+    """Naming power of ``candidate`` at ``magnitude`` from a ranking record's ``power`` rows.
+
+    Linear between the probe levels and held at the end ones (as the response is); NaN when the
+    record has no power for the candidate (the ranking did not run, or not with it).
+    """
+    rows = sorted(
+        (float(r["magnitude"]), float(r["named"])) for r in power if r["candidate"] == candidate
+    )
+    if not rows:
+        return math.nan
+    levels, shares = zip(*rows, strict=True)
+    return float(np.interp(magnitude, levels, shares))
 
 
 def pinned_text(pinned: Mapping[str, str]) -> str:
@@ -372,9 +396,17 @@ def matrix_scores(rows: pd.DataFrame) -> dict[str, Any]:
     )
     false_alarm, n_nothing = share("nothing", rows["outcome"] != NOTHING)
     outside, n_outside = share("outside")
+    # Catalogue studies whose ranking ran, and of those the ones whose data could name the
+    # hidden effect at its truth; the accuracy that any method could reach is on the latter.
+    power = rows["power_at_truth"] if "power_at_truth" in rows else pd.Series(math.nan, rows.index)
+    ranked = rows[(rows["kind"] == "catalogue") & power.notna()]
+    nameable = ranked[power.loc[ranked.index] >= UNNAMEABLE]
     return {
         "naming_accuracy": accuracy,
         "catalogue_studies": n_catalogue,
+        "ranked_studies": len(ranked),
+        "nameable_studies": len(nameable),
+        "nameable_accuracy": float(nameable["correct"].mean()) if len(nameable) else math.nan,
         "shortlist_accuracy": shortlist,
         "false_alarm_rate": false_alarm,
         "null_studies": n_nothing,
@@ -427,6 +459,10 @@ def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
         f"- Right effect named: {pct(scores['naming_accuracy'])} of "
         f"{scores['catalogue_studies']} studies with a hidden catalogue effect (goal 90 %); "
         f"named or one of two the data could not tell apart: {pct(scores['shortlist_accuracy'])}.",
+        f"- Of the {scores['ranked_studies']} catalogue studies that reached the naming step, "
+        f"the data could name the hidden effect at its truth (naming power at least "
+        f"{100 * UNNAMEABLE:.0f} % from the study's probe runs) in {scores['nameable_studies']}; "
+        f"of those named right: {pct(scores['nameable_accuracy'])}.",
         f"- False alarms with nothing hidden: {pct(scores['false_alarm_rate'])} of "
         f"{scores['null_studies']} (goal at most 5 %).",
         f"- Effect outside the catalogue: {pct(scores['outside_acceptable'])} of "

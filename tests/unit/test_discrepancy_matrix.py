@@ -26,6 +26,7 @@ from demcal.discrepancy.validation_matrix import (
     matrix_markdown,
     matrix_scores,
     placeholder_experiment,
+    power_at,
     study_outcome,
 )
 
@@ -78,9 +79,19 @@ def test_outcomes_are_read_from_the_study(tmp_path):
         "alpha": 0.05,
         "dem_values": 9,
     }
-    write_study(tmp_path / "a", named, truth, {"p_effect": 0.01, "p_runner_up": 0.02})
+    power = [
+        {"candidate": "cohesion", "magnitude": 40000.0, "found": 0.9, "named": 0.8},
+        {"candidate": "cohesion", "magnitude": 15000.0, "found": 0.3, "named": 0.2},
+        {"candidate": "rolling", "magnitude": 0.2, "found": 1.0, "named": 1.0},
+    ]
+    ranking = {"p_effect": 0.01, "p_runner_up": 0.02, "power": power}
+    write_study(tmp_path / "a", named, truth, ranking)
     row = study_outcome(cohesion, tmp_path / "a")
     assert (row["outcome"], row["correct"], row["pinned"]) == ("cohesion", True, "")
+    # The hidden effect's naming power at the truth (30 000), between its probe levels.
+    assert row["power_at_truth"] == pytest.approx(0.2 + 0.6 * 15 / 25)
+    assert power_at(power, "cohesion", 90000.0) == 0.8
+    assert math.isnan(power_at(power, "wallfriction", 0.5))
     assert row["magnitude_ratio"] == pytest.approx(0.8)
     assert row["held_out_dem_gap_after"] == 0.9
     # The same answer for a material that hides nothing is a false alarm.
@@ -158,6 +169,9 @@ def test_outcomes_are_read_from_the_study(tmp_path):
     row = study_outcome(none, tmp_path / "c")
     assert (row["outcome"], row["correct"]) == (NOTHING, True)
     assert math.isnan(row["p_effect"]) and math.isnan(row["dem_gap_before"])
+    # Nothing hidden: no power at a truth.
+    assert math.isnan(row["power_at_truth"])
+    assert math.isnan(study_outcome(cohesion, tmp_path / "c")["power_at_truth"])
 
 
 def test_confusion_matrix_and_scores():
@@ -205,6 +219,9 @@ def test_confusion_matrix_and_scores():
     )
     for column in (*GAP_COLUMNS, "magnitude_ratio"):
         full[column] = 1.0
+    # Of the catalogue studies, four reached the ranking; the data could name the hidden effect
+    # in three of them (power >= 50 %), two of which were named right.
+    full["power_at_truth"] = [0.9, 0.3, 0.7, 0.95, math.nan] + [math.nan] * 6
     full["pinned"] = [""] * 9 + ["coefficientFriction lower"] * 2
     # DEM check of the named effects: of the right cohesion namings one confirmed and one with
     # a gap left, the right rolling one confirmed, the wrong rolling naming of a cohesion study
@@ -217,6 +234,11 @@ def test_confusion_matrix_and_scores():
     assert "False alarms with nothing hidden: 25 % of 4" in text
     assert "| cohesion | 2 | 1 | 0 | 0 | 0 |" in text
     assert "named or one of two the data could not tell apart: 80 %" in text
+    assert (
+        "Of the 4 catalogue studies that reached the naming step, the data could name the hidden "
+        "effect at its truth (naming power at least 50 % from the study's probe runs) in 3; of "
+        "those named right: 67 %." in text
+    )
     assert (
         "DEM verdicts on named catalogue effects: right namings 3 (2 confirmed, 1 gap remains); "
         "wrong namings 1 (1 not confirmed)" in text

@@ -11,10 +11,11 @@ from demcal.discrepancy.best_fit import ParameterBox
 from demcal.discrepancy.effect_response import EffectResponse, response_signature
 from demcal.discrepancy.find import find
 from demcal.discrepancy.observations import SurrogateModel, observation_table
-from demcal.discrepancy.probe_ranking import _tested_winner
+from demcal.discrepancy.probe_ranking import _power_notes, _power_text, _tested_winner
 from demcal.discrepancy.ranking import (
     NamingTest,
     fit_candidate,
+    naming_power,
     naming_test,
     null_fit,
     rank_candidates,
@@ -279,3 +280,46 @@ def test_naming_decision_records_the_pair_it_cannot_tell_apart():
     # Both tests reject: named.
     clear = NamingTest("rolling", 0.001, "cohesion", 0.01, 0, 1000)
     assert _tested_winner("rolling", clear, 0.05, obs, notes) == ("rolling", None)
+
+
+def test_naming_power_is_the_rate_at_which_the_test_names_the_effect():
+    # A weak effect on half the values (1 and 2 sigma per value at its two levels), a tilt the
+    # grid cannot follow, and a shift along the model's own gradient that the parameter absorbs.
+    weak = _response("a", np.where(np.arange(_K) < 4, 0.05, 0.0))
+    absorbed = _response("u", 0.1 * np.linspace(1.0, 2.0, _K))
+    responses = {"a": weak, "b": _B, "u": absorbed}
+    power = naming_power(_GRID, _GRID[20], _W, responses, 0.05, 41, 400, 999, seed=3)
+    power = power.set_index(["candidate", "magnitude"])
+    # The absorbed effect is found only at the false-alarm rate and never leads: these data
+    # cannot name it at any magnitude. The tilt is named nearly always.
+    assert power.loc[("u", 2.0), "named"] == 0.0 and power.loc[("u", 2.0), "found"] <= 0.1
+    assert power.loc[("b", 2.0), "named"] >= 0.95
+    # The shares are what the naming test does on data drawn with the effect present: found and
+    # leading in about the same share of 100 data sets (binomial sd <= 0.05).
+    rng = np.random.default_rng(9)
+    for level in (1.0, 2.0):
+        tests = [
+            naming_test(_GRID, _data(rng, _GRID[20] + weak.at(level)), _W, responses, 41, 199, k)
+            for k in range(100)
+        ]
+        rate = np.mean([t.p_effect < 0.05 and t.top == "a" for t in tests])
+        expected = power.loc[("a", level), "named"]
+        assert 0.2 < expected < 0.8 and abs(rate - expected) <= 0.15, (level, rate, expected)
+
+
+def test_power_notes_name_the_candidates_the_data_cannot_name():
+    power = pd.DataFrame(
+        {
+            "candidate": ["cohesion"] * 3 + ["polydispersity"] * 3,
+            "magnitude": [15000.0, 40000.0, 65000.0, 2.0, 4.0, 6.0],
+            "found": [0.4, 0.9, 1.0, 0.1, 0.6, 0.3],
+            "named": [0.27, 0.84, 1.0, 0.06, 0.36, 0.2],
+        }
+    )
+    assert _power_text(power) == {
+        "cohesion": "1.5e+04: 27 %, 4e+04: 84 %, 6.5e+04: 100 %",
+        "polydispersity": "2: 6 %, 4: 36 %, 6: 20 %",
+    }
+    (note,) = _power_notes(power)
+    assert note.startswith("polydispersity could not be named from these measurements")
+    assert "probe level 4: data sets drawn with it there show an effect in 60 %" in note

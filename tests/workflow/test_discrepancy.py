@@ -152,6 +152,14 @@ def test_hidden_effect_is_found_and_never_misnamed(studies):
     assert not named or name in named, (named, result["ranking"])
     # The responses were taken against the mean of the three reference runs at theta*.
     assert "minus the mean of 3 at theta*" in (out / "ranking.md").read_text()
+    # The data that revealed the effect could name it had it been present at its strongest
+    # probe level; every scored candidate has its naming power per level.
+    power = pd.DataFrame(record["power"])
+    scored = {r["candidate"] for r in record["ranking"]}
+    assert (
+        set(power["candidate"]) == scored and power[["found", "named"]].stack().between(0, 1).all()
+    )
+    assert power.loc[power["candidate"] == name, "named"].max() >= 0.5, record["power"]
     if result["winner"] != name:
         assert not result["extended"], result
         return
