@@ -37,6 +37,7 @@ from demcal.discrepancy.ranking import (
     naming_power,
     naming_test,
     null_fit,
+    power_with_fixed,
     rank_candidates,
     ranking_sigma,
 )
@@ -225,7 +226,23 @@ def rank(
             int(settings["power_draws"]),
             int(settings["bootstrap_draws"]),
         )
-        notes += _power_notes(power)
+        fixed = {
+            name: power_with_fixed(
+                grid,
+                predictions,
+                list(box.names),
+                obs["measured"].to_numpy(float),
+                weights,
+                responses,
+                name,
+                float(settings["alpha"]),
+                int(settings["magnitude_points"]),
+                int(settings["power_draws"]),
+                int(settings["bootstrap_draws"]),
+            )
+            for name in _unnameable(power)
+        }
+        notes += _power_notes(power, fixed)
     ambiguous = None
     if winner_name is not None and test is not None:
         winner_name, ambiguous = _tested_winner(
@@ -261,19 +278,46 @@ def _power_text(power: pd.DataFrame) -> dict[str, str]:
     }
 
 
-def _power_notes(power: pd.DataFrame) -> list[str]:
-    """A note for each candidate that these measurements could not name at any probe level."""
+def _unnameable(power: pd.DataFrame) -> list[str]:
+    """Candidates whose naming power stays below :data:`UNNAMEABLE` at every probe level."""
+    best = power.groupby("candidate", sort=False)["named"].max()
+    return [str(name) for name, share in best.items() if share < UNNAMEABLE]
+
+
+def _power_notes(
+    power: pd.DataFrame, fixed: Mapping[str, Mapping[str, float]] | None = None
+) -> list[str]:
+    """A note for each candidate that these measurements could not name at any probe level,
+    with the parameters whose separate measurement would change that (``fixed``: candidate ->
+    parameter -> best power with that parameter held, :func:`power_with_fixed`)."""
     notes = []
-    for name, rows in power.groupby("candidate", sort=False):
+    for name in _unnameable(power):
+        rows = power[power["candidate"] == name]
         best = rows.loc[rows["named"].idxmax()]
-        if best["named"] < UNNAMEABLE:
-            notes.append(
-                f"{name} could not be named from these measurements even if it were present "
-                f"at its probe level {best['magnitude']:.3g}: data sets drawn with it there "
-                f"show an effect in {100 * best['found']:.0f} % and name it in at most "
-                f"{100 * best['named']:.0f} % - what it changes, the fitted parameters absorb "
-                "or the noise hides; a 'nothing missing' or another name does not rule it out"
+        note = (
+            f"{name} could not be named from these measurements even if it were present "
+            f"at its probe level {best['magnitude']:.3g}: data sets drawn with it there "
+            f"show an effect in {100 * best['found']:.0f} % and name it in at most "
+            f"{100 * best['named']:.0f} % - what it changes, the fitted parameters absorb "
+            "or the noise hides; a 'nothing missing' or another name does not rule it out"
+        )
+        held = (fixed or {}).get(name) or {}
+        helps = {p: v for p, v in held.items() if v >= UNNAMEABLE}
+        if helps:
+            note += "; it could be named with " + " or ".join(
+                f"{p} measured on its own (up to {100 * v:.0f} % with {p} held at its best-fit "
+                "value)"
+                for p, v in sorted(helps.items(), key=lambda item: -item[1])
             )
+        elif held:
+            top = max(held, key=held.__getitem__)
+            note += (
+                "; holding any one of "
+                + ", ".join(sorted(held))
+                + " at its best-fit value, as a measurement of it alone would, does not change "
+                f"that (at most {100 * held[top]:.0f} %, with {top} held)"
+            )
+        notes.append(note)
     return notes
 
 

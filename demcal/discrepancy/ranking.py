@@ -71,6 +71,7 @@ __all__ = [
     "naming_power",
     "naming_test",
     "null_fit",
+    "power_with_fixed",
     "rank_candidates",
     "ranking_sigma",
 ]
@@ -401,6 +402,7 @@ def naming_power(
     draws: int = 200,
     null_draws: int = 1000,
     seed: int = 1,
+    only: str | None = None,
 ) -> pd.DataFrame:
     """How often each candidate would be found and lead if it were present at a probe level.
 
@@ -434,6 +436,8 @@ def naming_power(
         Data sets under "nothing missing" for the critical drop.
     seed : int
         Seed of the draws.
+    only : str, optional
+        Draw data sets for this candidate's levels only (all candidates still compete).
 
     Returns
     -------
@@ -443,6 +447,8 @@ def naming_power(
     """
     if not responses:
         raise ValueError("naming_power needs at least one candidate")
+    if only is not None and only not in responses:
+        raise ValueError(f"naming_power: {only!r} is not a candidate")
     rng = np.random.default_rng(seed)
     w = np.asarray(weights, float)
     y = np.asarray(y, float)
@@ -453,6 +459,8 @@ def naming_power(
     null_drops = np.sort(_largest_drops(grid_predictions, offsets, null, w)[0])
     rows = []
     for i, name in enumerate(names):
+        if only is not None and name != only:
+            continue
         response = responses[name]
         for j, level in enumerate(response.magnitudes):
             if j == response.reference:
@@ -471,3 +479,64 @@ def naming_power(
                 }
             )
     return pd.DataFrame(rows, columns=["candidate", "magnitude", "found", "named"])
+
+
+def power_with_fixed(
+    grid: np.ndarray,
+    grid_predictions: np.ndarray,
+    names: list[str],
+    y: np.ndarray,
+    weights: np.ndarray,
+    responses: Mapping[str, EffectResponse],
+    candidate: str,
+    alpha: float,
+    magnitude_points: int = 41,
+    draws: int = 200,
+    null_draws: int = 1000,
+) -> dict[str, float]:
+    """A candidate's best naming power when one parameter is measured on its own.
+
+    Each free parameter in turn is held at the current model's best grid value (as a separate
+    measurement, e.g. a pycnometer particle density, would fix it) and :func:`naming_power` is
+    repeated on that slice of the grid. A parameter whose fixing lifts the power says which
+    extra measurement would let the data name the candidate. The held value is exact, as no
+    measurement is, so the power found is an upper bound on what that measurement gives.
+
+    Parameters
+    ----------
+    grid : ndarray, shape (G, d)
+        The parameter grid.
+    grid_predictions : ndarray, shape (G, K)
+        The current model's predictions over it.
+    names : list of str, length d
+        Parameter of each grid column.
+    y, weights, responses, alpha, magnitude_points, draws, null_draws
+        As for :func:`naming_power`.
+    candidate : str
+        The candidate whose power is wanted.
+
+    Returns
+    -------
+    dict
+        Parameter -> the candidate's largest ``named`` share over its probe levels with that
+        parameter fixed.
+    """
+    grid = np.asarray(grid, float)
+    w = np.asarray(weights, float)
+    best = int(np.argmin(np.sum(((grid_predictions - np.asarray(y, float)) / w) ** 2, axis=1)))
+    out = {}
+    for i, name in enumerate(names):
+        rows = np.isclose(grid[:, i], grid[best, i])
+        power = naming_power(
+            grid_predictions[rows],
+            y,
+            w,
+            responses,
+            alpha,
+            magnitude_points,
+            draws,
+            null_draws,
+            only=candidate,
+        )
+        out[name] = float(power["named"].max())
+    return out

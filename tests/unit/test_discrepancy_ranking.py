@@ -18,6 +18,7 @@ from demcal.discrepancy.ranking import (
     naming_power,
     naming_test,
     null_fit,
+    power_with_fixed,
     rank_candidates,
     ranking_sigma,
 )
@@ -307,6 +308,28 @@ def test_naming_power_is_the_rate_at_which_the_test_names_the_effect():
         assert 0.2 < expected < 0.8 and abs(rate - expected) <= 0.15, (level, rate, expected)
 
 
+def test_fixing_the_parameter_that_absorbs_an_effect_makes_it_nameable():
+    # Two parameters: t1 moves every value alike, t2 alternates. Candidate u shifts the values
+    # exactly as t2 does (0.2 of t2 per unit magnitude), so with t2 free it is absorbed; held
+    # at its best value (as a separate measurement of it would), u is plain. Holding t1 does
+    # not help.
+    axis = np.linspace(0.0, 1.0, 21)
+    grid = np.array([(a, b) for a in axis for b in axis])
+    up = np.ones(_K)
+    alternate = np.where(np.arange(_K) % 2 == 0, 1.0, -1.0)
+    predictions = np.outer(grid[:, 0], up) + np.outer(grid[:, 1], alternate)
+    responses = {"u": _response("u", 0.2 * alternate), "b": _B}
+    y = predictions[int(np.flatnonzero((grid[:, 0] == 0.5) & (grid[:, 1] == 0.25))[0])]
+    free = naming_power(predictions, y, _W, responses, 0.05, 41, 200, 999, only="u")
+    assert free["named"].max() <= 0.05 and set(free["candidate"]) == {"u"}
+    held = power_with_fixed(
+        grid, predictions, ["t1", "t2"], y, _W, responses, "u", 0.05, 41, 200, 999
+    )
+    assert held["t2"] >= 0.95 and held["t1"] <= 0.05, held
+    with pytest.raises(ValueError, match="not a candidate"):
+        naming_power(predictions, y, _W, responses, 0.05, only="x")
+
+
 def test_power_notes_name_the_candidates_the_data_cannot_name():
     power = pd.DataFrame(
         {
@@ -323,3 +346,13 @@ def test_power_notes_name_the_candidates_the_data_cannot_name():
     (note,) = _power_notes(power)
     assert note.startswith("polydispersity could not be named from these measurements")
     assert "probe level 4: data sets drawn with it there show an effect in 60 %" in note
+    # With the powers of one parameter held at a time: which measurement would help, if any.
+    helps = {"polydispersity": {"density": 0.8, "coefficientFriction": 0.1}}
+    (note,) = _power_notes(power, helps)
+    assert note.endswith(
+        "it could be named with density measured on its own (up to 80 % with density held at "
+        "its best-fit value)"
+    )
+    nothing = {"polydispersity": {"density": 0.47, "coefficientFriction": 0.1}}
+    (note,) = _power_notes(power, nothing)
+    assert note.endswith("does not change that (at most 47 %, with density held)")
