@@ -224,7 +224,7 @@ def rank(
             float(settings["alpha"]),
             int(settings["magnitude_points"]),
             int(settings["power_draws"]),
-            int(settings["bootstrap_draws"]),
+            null_drops=test.null_drops if test is not None else None,
         )
         fixed = {
             name: power_with_fixed(

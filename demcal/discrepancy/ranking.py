@@ -55,7 +55,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -285,6 +285,9 @@ class NamingTest:
         Index of the measured value where the two fits differ most in units of its weight.
     draws : int
         Bootstrap data sets per test.
+    null_drops : ndarray, shape (draws,)
+        The largest deviance drop of each data set drawn under "nothing missing" (the null
+        distribution of the effect test; :func:`naming_power` reuses it).
     """
 
     top: str
@@ -293,6 +296,7 @@ class NamingTest:
     p_runner_up: float | None
     separating: int | None
     draws: int
+    null_drops: np.ndarray = field(default_factory=lambda: np.empty(0), repr=False, compare=False)
 
 
 def _offsets(response: EffectResponse, magnitude_points: int) -> list[np.ndarray]:
@@ -378,7 +382,7 @@ def naming_test(
     drops, _ = _largest_drops(grid_predictions, list(offsets.values()), data, w)
     p_effect = float((1 + np.count_nonzero(drops >= d0 - dc[top])) / (draws + 1))
     if len(order) < 2:
-        return NamingTest(top, p_effect, None, None, None, draws)
+        return NamingTest(top, p_effect, None, None, None, draws, drops)
     # Is it the top candidate rather than the runner-up: data drawn from the runner-up's fit.
     second = order[1]
     top_point = _best_row(grid_predictions, offsets[top], y, w)
@@ -389,7 +393,7 @@ def naming_test(
     )
     p_second = float((1 + np.count_nonzero(gaps >= dc[second] - dc[top])) / (draws + 1))
     separating = int(np.argmax(np.abs(top_point - second_point) / w))
-    return NamingTest(top, p_effect, second, p_second, separating, draws)
+    return NamingTest(top, p_effect, second, p_second, separating, draws, drops)
 
 
 def naming_power(
@@ -403,6 +407,7 @@ def naming_power(
     null_draws: int = 1000,
     seed: int = 1,
     only: str | None = None,
+    null_drops: np.ndarray | None = None,
 ) -> pd.DataFrame:
     """How often each candidate would be found and lead if it were present at a probe level.
 
@@ -438,6 +443,9 @@ def naming_power(
         Seed of the draws.
     only : str, optional
         Draw data sets for this candidate's levels only (all candidates still compete).
+    null_drops : ndarray, optional
+        The null distribution of the effect test on the same data, grid, weights and
+        candidates (``NamingTest.null_drops``); drawn here (``null_draws``) when not given.
 
     Returns
     -------
@@ -455,8 +463,10 @@ def naming_power(
     names = list(responses)
     offsets = [_offsets(responses[c], magnitude_points) for c in names]
     base = _best_row(grid_predictions, [np.zeros_like(y)], y, w)
-    null = base + w * rng.standard_normal((null_draws, y.size))
-    null_drops = np.sort(_largest_drops(grid_predictions, offsets, null, w)[0])
+    if null_drops is None:
+        null = base + w * rng.standard_normal((null_draws, y.size))
+        null_drops = _largest_drops(grid_predictions, offsets, null, w)[0]
+    null_drops = np.sort(np.asarray(null_drops, float))
     rows = []
     for i, name in enumerate(names):
         if only is not None and name != only:

@@ -306,6 +306,12 @@ def test_naming_power_is_the_rate_at_which_the_test_names_the_effect():
         rate = np.mean([t.p_effect < 0.05 and t.top == "a" for t in tests])
         expected = power.loc[("a", level), "named"]
         assert 0.2 < expected < 0.8 and abs(rate - expected) <= 0.15, (level, rate, expected)
+    # The naming test's own null distribution serves as well (the Name step reuses it).
+    null = naming_test(_GRID, _GRID[20], _W, responses, 41, 999, seed=4).null_drops
+    assert null.shape == (999,)
+    again = naming_power(_GRID, _GRID[20], _W, responses, 0.05, 41, 400, seed=3, null_drops=null)
+    shift = again.set_index(["candidate", "magnitude"])["named"] - power["named"]
+    assert shift.abs().max() <= 0.1, shift
 
 
 def test_fixing_the_parameter_that_absorbs_an_effect_makes_it_nameable():
