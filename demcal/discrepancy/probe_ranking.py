@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -204,44 +205,21 @@ def rank(
             f"{winner_name} leads, but is not named: {', '.join(unscored)} could not be scored"
         )
         winner_name = None
+    y = obs["measured"].to_numpy(float)
+    alpha, points = float(settings["alpha"]), int(settings["magnitude_points"])
+    boot = int(settings["bootstrap_draws"])
     test = None
     if responses:
-        test = naming_test(
-            predictions,
-            obs["measured"].to_numpy(float),
-            weights,
-            responses,
-            int(settings["magnitude_points"]),
-            int(settings["bootstrap_draws"]),
-        )
+        test = naming_test(predictions, y, weights, responses, points, boot)
     power = None
-    if responses and int(settings["power_draws"]) > 0:
+    if test is not None and int(settings["power_draws"]) > 0:
+        draws = int(settings["power_draws"])
         power = naming_power(
-            predictions,
-            obs["measured"].to_numpy(float),
-            weights,
-            responses,
-            float(settings["alpha"]),
-            int(settings["magnitude_points"]),
-            int(settings["power_draws"]),
-            null_drops=test.null_drops if test is not None else None,
+            predictions, y, weights, responses, alpha, points, draws, null_drops=test.null_drops
         )
-        fixed = {
-            name: power_with_fixed(
-                grid,
-                predictions,
-                list(box.names),
-                obs["measured"].to_numpy(float),
-                weights,
-                responses,
-                name,
-                float(settings["alpha"]),
-                int(settings["magnitude_points"]),
-                int(settings["power_draws"]),
-                int(settings["bootstrap_draws"]),
-            )
-            for name in _unnameable(power)
-        }
+        # Each candidate the data cannot name, again with one parameter held at a time.
+        hold = partial(power_with_fixed, grid, predictions, list(box.names), y, weights, responses)
+        fixed = {c: hold(c, alpha, points, draws, boot) for c in _unnameable(power)}
         notes += _power_notes(power, fixed)
     ambiguous = None
     if winner_name is not None and test is not None:

@@ -423,18 +423,10 @@ def naming_power(
 
     Parameters
     ----------
-    grid_predictions : ndarray, shape (G, K)
-        The current model's predictions over the parameter grid.
-    y : ndarray, shape (K,)
-        Measured values.
-    weights : ndarray, shape (K,)
-        Ranking weights (:func:`ranking_sigma`).
-    responses : mapping
-        Candidate name -> DEM response; at least one.
+    grid_predictions, y, weights, responses, magnitude_points
+        As for :func:`naming_test` (shapes (G, K), (K,), (K,)).
     alpha : float
         Significance level of the effect test.
-    magnitude_points : int
-        Magnitudes tried per continuous candidate, as in :func:`fit_candidate`.
     draws : int
         Data sets per candidate and probe level.
     null_draws : int
