@@ -18,6 +18,7 @@ __all__ = [
     "BestFit",
     "ParameterBox",
     "best_deviances",
+    "exceedance_p",
     "grid_size",
     "minimise_chi2",
     "pinned_parameters",
@@ -220,3 +221,23 @@ def best_deviances(rows: np.ndarray, data: np.ndarray, weights: np.ndarray) -> n
         best = np.min(norms[:, None] - 2.0 * scaled @ u.T, axis=0)
         out[start : start + len(u)] = np.maximum(best + np.sum(u**2, axis=1), 0.0)
     return out
+
+
+def exceedance_p(null: np.ndarray, observed: float | np.ndarray) -> np.ndarray:
+    """Parametric-bootstrap p-value of each observed statistic against the null draws,
+    ``(1 + #{null >= observed}) / (n + 1)`` (never 0, so a p-value resolves 1 / (n + 1)).
+
+    Parameters
+    ----------
+    null : ndarray, shape (n,)
+        The statistic over the data sets drawn under the null hypothesis.
+    observed : float or ndarray, shape (m,)
+        Observed statistic(s).
+
+    Returns
+    -------
+    ndarray, shape of ``observed``
+    """
+    ordered = np.sort(np.asarray(null, float))
+    exceed = ordered.size - np.searchsorted(ordered, observed, side="left")
+    return (1.0 + exceed) / (ordered.size + 1.0)

@@ -39,6 +39,7 @@ from demcal.discrepancy.best_fit import (
     BestFit,
     ParameterBox,
     best_deviances,
+    exceedance_p,
     minimise_chi2,
     pinned_parameters,
 )
@@ -234,7 +235,7 @@ def find(
     # The observed statistic is the grid minimum, as for the bootstrap sets.
     g0 = int(np.argmin(chi2))
     null = null_deviances(F, F[g0], sigma, draws, seed)
-    p_value = float((1 + np.count_nonzero(null >= chi2[g0])) / (draws + 1))
+    p_value = float(exceedance_p(null, chi2[g0]))
     return FindResult(obs, best, gap, alpha, sentences, pinned, n_free, p_value, draws)
 
 

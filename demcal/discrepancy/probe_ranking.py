@@ -33,6 +33,7 @@ from demcal.discrepancy.model_from_files import (
 )
 from demcal.discrepancy.observations import SurrogateModel
 from demcal.discrepancy.ranking import (
+    UNNAMEABLE,
     NamingTest,
     fit_candidate,
     naming_power,
@@ -45,10 +46,7 @@ from demcal.discrepancy.ranking import (
 from demcal.discrepancy.report import condition_label, ranking_markdown
 from demcal.discrepancy.run_results import read_runs, replicate_statistics
 
-__all__ = ["UNNAMEABLE", "RankingResult", "rank", "ranking_record", "write_ranking"]
-
-#: Naming power below which a candidate counts as not nameable from the measurements.
-UNNAMEABLE = 0.5
+__all__ = ["RankingResult", "rank", "ranking_record", "write_ranking"]
 
 
 @dataclass

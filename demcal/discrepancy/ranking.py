@@ -60,11 +60,18 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from demcal.discrepancy.best_fit import BestFit, ParameterBox, best_deviances, minimise_chi2
+from demcal.discrepancy.best_fit import (
+    BestFit,
+    ParameterBox,
+    best_deviances,
+    exceedance_p,
+    minimise_chi2,
+)
 from demcal.discrepancy.effect_response import EffectResponse
 from demcal.discrepancy.observations import SurrogateModel
 
 __all__ = [
+    "UNNAMEABLE",
     "CandidateFit",
     "NamingTest",
     "fit_candidate",
@@ -75,6 +82,11 @@ __all__ = [
     "rank_candidates",
     "ranking_sigma",
 ]
+
+
+#: Naming power below which a candidate counts as not nameable from the measurements
+#: (:func:`naming_power`).
+UNNAMEABLE = 0.5
 
 
 @dataclass
@@ -380,7 +392,7 @@ def naming_test(
     null_point = _best_row(grid_predictions, [np.zeros_like(y)], y, w)
     data = null_point + w * rng.standard_normal((draws, y.size))
     drops, _ = _largest_drops(grid_predictions, list(offsets.values()), data, w)
-    p_effect = float((1 + np.count_nonzero(drops >= d0 - dc[top])) / (draws + 1))
+    p_effect = float(exceedance_p(drops, d0 - dc[top]))
     if len(order) < 2:
         return NamingTest(top, p_effect, None, None, None, draws, drops)
     # Is it the top candidate rather than the runner-up: data drawn from the runner-up's fit.
@@ -391,7 +403,7 @@ def naming_test(
     gaps = _best(grid_predictions, offsets[second], data, w) - _best(
         grid_predictions, offsets[top], data, w
     )
-    p_second = float((1 + np.count_nonzero(gaps >= dc[second] - dc[top])) / (draws + 1))
+    p_second = float(exceedance_p(gaps, dc[second] - dc[top]))
     separating = int(np.argmax(np.abs(top_point - second_point) / w))
     return NamingTest(top, p_effect, second, p_second, separating, draws, drops)
 
@@ -458,7 +470,6 @@ def naming_power(
     if null_drops is None:
         null = base + w * rng.standard_normal((null_draws, y.size))
         null_drops = _largest_drops(grid_predictions, offsets, null, w)[0]
-    null_drops = np.sort(np.asarray(null_drops, float))
     rows = []
     for i, name in enumerate(names):
         if only is not None and name != only:
@@ -469,9 +480,7 @@ def naming_power(
                 continue
             data = base + response.responses[j] + w * rng.standard_normal((draws, y.size))
             drops, leader = _largest_drops(grid_predictions, offsets, data, w)
-            # p = (1 + #{null drops >= drop}) / (null_draws + 1), as for p_effect.
-            exceed = null_drops.size - np.searchsorted(null_drops, drops, side="left")
-            found = (1 + exceed) / (null_drops.size + 1) < alpha
+            found = exceedance_p(null_drops, drops) < alpha  # as p_effect
             rows.append(
                 {
                     "candidate": name,

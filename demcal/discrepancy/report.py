@@ -17,6 +17,7 @@ import pandas as pd
 from demcal.discrepancy.effect_verdict import CONFIRMED, GAP_REMAINS
 from demcal.discrepancy.find import FindResult
 from demcal.discrepancy.observations import format_stress
+from demcal.discrepancy.ranking import UNNAMEABLE
 
 #: DEM replicate statistics per observation: mean, sd and number of runs, shape (K,) each.
 Replicates = tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -159,7 +160,8 @@ def ranking_markdown(
             "power: per probe level, the share of data sets drawn with the candidate present at "
             "that level (the current model's best fit plus its response plus noise) in which "
             "the effect test rejects 'nothing missing' and the candidate leads - an upper bound "
-            "on how often these measurements would name it. Below 50 % at every level they "
+            f"on how often these measurements would name it. Below {100 * UNNAMEABLE:.0f} % at "
+            "every level they "
             "cannot name it, and not naming it says nothing about its presence.",
         ]
     descriptions = table[["candidate", "description"]].drop_duplicates()

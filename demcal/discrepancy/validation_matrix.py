@@ -33,7 +33,7 @@ import yaml
 from demcal.core.config import validate_config
 from demcal.core.snakemake_run import run_snakemake
 from demcal.discrepancy.effect_verdict import CONFIRMED, effect_verdict, fitted_dem_values
-from demcal.discrepancy.probe_ranking import UNNAMEABLE
+from demcal.discrepancy.ranking import UNNAMEABLE
 from demcal.discrepancy.report import markdown_table
 from demcal.discrepancy.synthetic import (
     study_config,

@@ -7,7 +7,12 @@ import pandas as pd
 import pytest
 
 from demcal.core.experiments import Experiment, MeasuredCondition
-from demcal.discrepancy.best_fit import ParameterBox, minimise_chi2, pinned_parameters
+from demcal.discrepancy.best_fit import (
+    ParameterBox,
+    exceedance_p,
+    minimise_chi2,
+    pinned_parameters,
+)
 from demcal.discrepancy.find import describe_disagreement, find
 from demcal.discrepancy.observations import SurrogateModel, format_stress, observation_table
 
@@ -247,3 +252,10 @@ def test_find_false_alarm_rate_is_alpha_and_an_effect_is_found():
         for k in range(50)
     ]
     assert sum(found) >= 45, sum(found)
+
+
+def test_bootstrap_p_value_counts_null_draws_at_or_above_the_observed():
+    # (1 + #{null >= observed}) / (n + 1), for one value or many; ties count as exceeding.
+    null = np.array([4.0, 1.0, 3.0, 2.0])
+    assert float(exceedance_p(null, 3.0)) == pytest.approx(3 / 5)
+    np.testing.assert_allclose(exceedance_p(null, np.array([0.5, 4.0, 9.0])), [1.0, 2 / 5, 1 / 5])
