@@ -10,6 +10,9 @@ Example::
 
     python scripts/compare_engines.py --config config/tiny.yaml --seeds 4 \
         --sets low middle cohesion --out results/engine_comparison/tiny
+    python scripts/compare_engines.py --config config/tiny.yaml --seeds 6 --sets \
+        --set wet coefficientFriction=0.57 coefficientRollingFriction=0 \
+        cohesionEnergyDensity=5.6e4 --out results/engine_comparison/wet
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     collect_values,
     load_status,
+    parameter_set_from_words,
     plan_runs,
     run_jobs,
     select_parameter_sets,
@@ -76,9 +80,19 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     parser.add_argument(
         "--sets",
-        nargs="+",
+        nargs="*",
         default=["low", "middle", "cohesion"],
-        help="parameter sets (low, middle, high, interlocking, cohesion)",
+        help="named parameter sets (low, middle, high, interlocking, cohesion; none: only --set)",
+    )
+    parser.add_argument(
+        "--set",
+        dest="own_sets",
+        nargs="+",
+        action="append",
+        default=[],
+        metavar="WORD",
+        help="a set of your own, run after --sets: NAME key=value ... (parameters not given as "
+        "in the low set); repeat for more sets",
     )
     parser.add_argument(
         "--engines",
@@ -113,6 +127,11 @@ def main(argv: list[str] | None = None) -> int:
     settings = load_config(Path(args.config))
     try:
         sets = select_parameter_sets(args.sets, str(settings.get("profile", "tiny")))
+        for words in args.own_sets:
+            name, params = parameter_set_from_words(words)
+            if name in sets:
+                raise ValueError(f"set {name} is given twice")
+            sets[name] = params
     except ValueError as exc:
         raise SystemExit(str(exc)) from None
     names = set(args.engines) | set(args.compare)
@@ -152,7 +171,7 @@ def main(argv: list[str] | None = None) -> int:
     bad = values[values["status"] != "ok"].drop_duplicates(["set", "engine", "seed", "test"])
     stress = args.normal_stress or settings["shear_cell"]["normal_stresses"][0]
     text = (
-        f"Config {args.config}, sets {', '.join(args.sets)}, seeds {seeds}, shear cell at "
+        f"Config {args.config}, sets {', '.join(sets)}, seeds {seeds}, shear cell at "
         f"{stress:g} Pa and P = {args.P:g}; started {started:%Y-%m-%d %H:%M} UTC, "
         f"wall time of this call {wall / 60:.1f} min ({len(jobs)} runs compared).\n"
     )
