@@ -29,6 +29,7 @@ from demcal.discrepancy.validation_matrix import (
     prepare_base,
     run_case,
     study_outcome,
+    with_signal,
 )
 from demcal.engine_io.run import installed_liggghts
 
@@ -83,7 +84,7 @@ def main() -> None:
                 continue
         rows.append(row)
         print(f"{case.name}: {row['outcome']}", flush=True)
-        table = pd.DataFrame(rows)
+        table = with_signal(pd.DataFrame(rows), args.out)
         table.to_csv(args.out / "matrix.csv", index=False, float_format="%.6g")
         command = "python " + " ".join(shlex.quote(a) for a in sys.argv)
         (args.out / "matrix.md").write_text(

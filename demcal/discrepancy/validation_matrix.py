@@ -31,8 +31,10 @@ import pandas as pd
 import yaml
 
 from demcal.core.config import validate_config
+from demcal.core.experiments import load_experiment
 from demcal.core.snakemake_run import run_snakemake
 from demcal.discrepancy.effect_verdict import CONFIRMED, effect_verdict, fitted_dem_values
+from demcal.discrepancy.observations import OBSERVABLES, observation_table
 from demcal.discrepancy.ranking import UNNAMEABLE
 from demcal.discrepancy.report import markdown_table
 from demcal.discrepancy.synthetic import (
@@ -48,6 +50,7 @@ __all__ = [
     "NOTHING",
     "NOT_EXPLAINED",
     "REPORT_COLUMNS",
+    "VISIBLE_SIGNAL",
     "MatrixCase",
     "confusion_matrix",
     "matrix_cases",
@@ -59,6 +62,8 @@ __all__ = [
     "prepare_base",
     "run_case",
     "study_outcome",
+    "twin_signal",
+    "with_signal",
 ]
 
 #: Outcome when Find sees no gap.
@@ -79,12 +84,19 @@ GAP_COLUMNS = (
     "held_out_dem_gap_before",
     "held_out_dem_gap_after",
 )
+#: Signal of a hidden effect (rms over the measured values of the difference to the
+#: nothing-hidden twin, in measurement sd; see :func:`twin_signal`) from which it counts as
+#: visible in the measurements. Two samples of one material differ by the replicate scatter of
+#: both, at most sqrt(2) sd in expectation, and an rms of 12 such differences exceeds 2 with
+#: less than 5 % probability.
+VISIBLE_SIGNAL = 2.0
 #: Columns of the per-study table of the matrix report.
 REPORT_COLUMNS = (
     "hidden",
     "truth_seed",
     "truth_friction",
     "truth_magnitude",
+    "signal",
     "outcome",
     "p_find",
     "p_effect",
@@ -319,6 +331,69 @@ def power_at(power: Sequence[Mapping[str, Any]], candidate: str, magnitude: floa
     return float(np.interp(magnitude, levels, shares))
 
 
+def twin_signal(study: str | Path, twin: str | Path) -> float:
+    """How far a hidden effect moves the measurements: the difference to its nothing-hidden twin.
+
+    The twin is the study with nothing hidden and the same truth seed: the same drawn
+    parameters, the same insertion seeds of its truth runs and the same noise draws, so the
+    difference of the two studies' measured values is the effect (on the truth engine, not on
+    the model under calibration) plus the replicate scatter of both. It needs no probe run and
+    is known whatever the workflow said.
+
+    Parameters
+    ----------
+    study, twin : path
+        Study directories (``config/experiments/measured.yaml`` and ``truth.yaml`` inside).
+
+    Returns
+    -------
+    float
+        sqrt(mean(((y - y_twin) / sd)^2)) over the values both measured, sd the study's
+        measurement sd (-); NaN when the studies' drawn parameters differ (not twins) or they
+        share no measured value. About 1 or less: the effect stays within the measurement
+        error, and no method can name it from these measurements.
+    """
+    study, twin = Path(study), Path(twin)
+    mine = yaml.safe_load((study / "truth.yaml").read_text())
+    other = yaml.safe_load((twin / "truth.yaml").read_text())
+    # The hidden effect's own parameters (drawn in the study only, e.g. a rolling friction the
+    # twin holds at 0) differ by design; every other parameter must match.
+    effect = set(mine.get("drawn") or {}) - set(other.get("drawn") or {})
+    shared = (set(mine["parameters"]) & set(other["parameters"])) - effect
+    if any(float(mine["parameters"][k]) != float(other["parameters"][k]) for k in shared):
+        return math.nan
+    keys = ["observable", "normal_stress", "P"]
+    unit_error = dict.fromkeys(OBSERVABLES, 0.0)
+
+    def table(path: Path) -> pd.DataFrame:
+        return observation_table(load_experiment(path / EXPERIMENT), unit_error, 1.0)
+
+    both = table(study).merge(table(twin), on=keys, suffixes=("", "_twin"))
+    if not len(both):
+        return math.nan
+    z = (both["measured"] - both["measured_twin"]) / both["measured_sd"]
+    return float(np.sqrt(np.mean(np.square(z))))
+
+
+def with_signal(rows: pd.DataFrame, out_dir: str | Path) -> pd.DataFrame:
+    """The matrix rows with a ``signal`` column (:func:`twin_signal`) for every study that has
+    a finished nothing-hidden twin in ``out_dir``; NaN for the others and the null studies."""
+    out_dir = Path(out_dir)
+    twins = {
+        int(r.truth_seed): out_dir / f"{r.hidden}_{int(r.truth_seed)}"
+        for r in rows.itertuples()
+        if r.kind == "nothing"
+    }
+    signal = []
+    for r in rows.itertuples():
+        # A row's ``hidden`` is its case label, which names the study directory.
+        twin = twins.get(int(r.truth_seed))
+        study = out_dir / f"{r.hidden}_{int(r.truth_seed)}"
+        found = r.kind != "nothing" and twin is not None and study.is_dir()
+        signal.append(twin_signal(study, twin) if found else math.nan)
+    return rows.assign(signal=signal)
+
+
 def pinned_text(pinned: Mapping[str, str]) -> str:
     """Find's parameters at a bound of the box, as ``"coefficientFriction lower"`` ("" if none).
 
@@ -401,12 +476,20 @@ def matrix_scores(rows: pd.DataFrame) -> dict[str, Any]:
     power = rows["power_at_truth"] if "power_at_truth" in rows else pd.Series(math.nan, rows.index)
     ranked = rows[(rows["kind"] == "catalogue") & power.notna()]
     nameable = ranked[power.loc[ranked.index] >= UNNAMEABLE]
+    # Catalogue studies whose hidden effect moved the measurements beyond their error, judged
+    # on the truth engine's data against the nothing-hidden twin (no probe, no model).
+    signal = rows["signal"] if "signal" in rows else pd.Series(math.nan, rows.index)
+    measured = rows[(rows["kind"] == "catalogue") & signal.notna()]
+    visible = measured[signal.loc[measured.index] >= VISIBLE_SIGNAL]
     return {
         "naming_accuracy": accuracy,
         "catalogue_studies": n_catalogue,
         "ranked_studies": len(ranked),
         "nameable_studies": len(nameable),
         "nameable_accuracy": float(nameable["correct"].mean()) if len(nameable) else math.nan,
+        "signal_studies": len(measured),
+        "visible_studies": len(visible),
+        "visible_accuracy": float(visible["correct"].mean()) if len(visible) else math.nan,
         "shortlist_accuracy": shortlist,
         "false_alarm_rate": false_alarm,
         "null_studies": n_nothing,
@@ -429,6 +512,18 @@ def _confirmation_line(rows: pd.DataFrame) -> str:
         return f"{len(part)} ({found})" if len(part) else "0"
 
     return f"right namings {count(right)}; wrong namings {count(wrong)}"
+
+
+def _signal_line(rows: pd.DataFrame) -> str:
+    """Range of the twin signal per hidden effect (studies with a twin only)."""
+    if "signal" not in rows:
+        return "-"
+    parts = []
+    for label, group in rows.groupby("hidden", sort=False):
+        values = group["signal"].dropna()
+        if len(values):
+            parts.append(f"{label} {values.min():.2g}-{values.max():.2g}")
+    return "; ".join(parts) or "-"
 
 
 def _pinned_line(rows: pd.DataFrame) -> str:
@@ -463,6 +558,11 @@ def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
         f"the data could name the hidden effect at its truth (naming power at least "
         f"{100 * UNNAMEABLE:.0f} % from the study's probe runs) in {scores['nameable_studies']}; "
         f"of those named right: {pct(scores['nameable_accuracy'])}.",
+        f"- Of the {scores['signal_studies']} catalogue studies with a nothing-hidden twin, the "
+        f"hidden effect moved the measurements by at least {VISIBLE_SIGNAL:g} measurement sd "
+        f"(rms of the difference to the twin) in {scores['visible_studies']}; of those named "
+        f"right: {pct(scores['visible_accuracy'])}. Signal per hidden effect: "
+        f"{_signal_line(rows)}.",
         f"- False alarms with nothing hidden: {pct(scores['false_alarm_rate'])} of "
         f"{scores['null_studies']} (goal at most 5 %).",
         f"- Effect outside the catalogue: {pct(scores['outside_acceptable'])} of "
@@ -477,6 +577,6 @@ def matrix_markdown(rows: pd.DataFrame, title: str, command: str) -> str:
         "Studies (gaps are sqrt(mean z^2); DEM gaps are the mean of the replicate runs, the "
         "held-out ones at the load no step fitted):",
         "",
-        markdown_table(rows[list(REPORT_COLUMNS)], ".3g"),
+        markdown_table(rows.reindex(columns=list(REPORT_COLUMNS)), ".3g"),
     ]
     return "\n".join(lines)

@@ -16,6 +16,7 @@ from demcal.discrepancy.effect_verdict import (
     dem_noise_bound,
     effect_verdict,
 )
+from demcal.discrepancy.synthetic import replicate_record
 from demcal.discrepancy.validation_matrix import (
     AMBIGUOUS,
     GAP_COLUMNS,
@@ -28,6 +29,8 @@ from demcal.discrepancy.validation_matrix import (
     placeholder_experiment,
     power_at,
     study_outcome,
+    twin_signal,
+    with_signal,
 )
 
 TRUTHS = Path(__file__).resolve().parents[2] / "config" / "experiments" / "truth"
@@ -223,6 +226,9 @@ def test_confusion_matrix_and_scores():
     # in three of them (power >= 50 %), two of which were named right.
     full["power_at_truth"] = [0.9, 0.3, 0.7, 0.95, math.nan] + [math.nan] * 6
     full["pinned"] = [""] * 9 + ["coefficientFriction lower"] * 2
+    # Twin signal: the first cohesion study's effect stayed within the noise, the rolling ones
+    # and the other cohesion studies moved the measurements; the null rows have none.
+    full["signal"] = [0.9, 2.5, 3.0, 6.0, 5.5] + [math.nan] * 4 + [4.0, 4.2]
     # DEM check of the named effects: of the right cohesion namings one confirmed and one with
     # a gap left, the right rolling one confirmed, the wrong rolling naming of a cohesion study
     # not confirmed.
@@ -238,6 +244,12 @@ def test_confusion_matrix_and_scores():
         "Of the 4 catalogue studies that reached the naming step, the data could name the hidden "
         "effect at its truth (naming power at least 50 % from the study's probe runs) in 3; of "
         "those named right: 67 %." in text
+    )
+    assert (
+        "Of the 5 catalogue studies with a nothing-hidden twin, the hidden effect moved the "
+        "measurements by at least 2 measurement sd (rms of the difference to the twin) in 4; of "
+        "those named right: 50 %. Signal per hidden effect: cohesion 0.9-3; rolling 5.5-6; "
+        "softer 4-4.2." in text
     )
     assert (
         "DEM verdicts on named catalogue effects: right namings 3 (2 confirmed, 1 gap remains); "
@@ -288,3 +300,74 @@ def test_a_gap_left_above_the_noise_is_not_a_confirmation():
     assert effect_verdict(2.9, 3.0, 2.7, 0.76, 9, 0.05) == NOT_CONFIRMED
     with pytest.raises(ValueError, match="n_values"):
         dem_noise_bound(0, 0.05)
+
+
+def write_twin(
+    work: Path, parameters: dict, values: dict[float, tuple[float, float]], drawn: dict
+) -> None:
+    """A study directory with its truth and a measured mu_psh, rho_b per normal stress."""
+    (work / "config" / "experiments").mkdir(parents=True)
+    truth = {"parameters": parameters, "drawn": drawn}
+    (work / "truth.yaml").write_text(yaml.safe_dump(truth))
+    conditions = [
+        {"normal_stress": s, "P": 0.5, "mu_psh": m, "mu_psh_sd": 0.02, "rho_b": r,
+         "rho_b_sd": 10.0}
+        for s, (m, r) in values.items()
+    ]  # fmt: skip
+    record = {"material": "m", "shear_cell": conditions}
+    (work / "config" / "experiments" / "measured.yaml").write_text(yaml.safe_dump(record))
+
+
+def test_twin_signal_is_the_effect_in_measurement_sd(tmp_path):
+    base = {"coefficientFriction": 0.5, "coefficientRollingFriction": 0.0, "density": 2500.0}
+    drawn = {"coefficientFriction": 0.5}
+    values = {1000.0: (0.50, 1500.0), 2000.0: (0.48, 1510.0)}
+    write_twin(tmp_path / "none_7", base, values, drawn)
+    # The hidden rolling resistance is drawn in the study and held at 0 in the twin.
+    write_twin(
+        tmp_path / "rolling_7",
+        {**base, "coefficientRollingFriction": 0.2},
+        {1000.0: (0.56, 1470.0), 2000.0: (0.50, 1505.0)},
+        {**drawn, "coefficientRollingFriction": 0.2},
+    )
+    # z = (0.06/0.02, -30/10, 0.02/0.02, -5/10) = (3, -3, 1, -0.5): rms sqrt(19.25 / 4).
+    expected = math.sqrt((9 + 9 + 1 + 0.25) / 4)
+    assert twin_signal(tmp_path / "rolling_7", tmp_path / "none_7") == pytest.approx(expected)
+    # A nothing-hidden study with another drawn friction is not a twin.
+    other = {"coefficientFriction": 0.6}
+    write_twin(tmp_path / "none_8", {**base, **other}, {1000.0: (0.5, 1500.0)}, other)
+    assert math.isnan(twin_signal(tmp_path / "rolling_7", tmp_path / "none_8"))
+    rows = pd.DataFrame(
+        {
+            "hidden": ["rolling", "none", "rolling"],
+            "kind": ["catalogue", "nothing", "catalogue"],
+            "truth_seed": [7, 7, 9],
+        }
+    )
+    signal = with_signal(rows, tmp_path)["signal"].tolist()
+    # The null study itself and a study without a twin get none.
+    assert signal[0] == pytest.approx(expected)
+    assert math.isnan(signal[1]) and math.isnan(signal[2])
+
+
+def test_twins_share_their_noise_draws():
+    # The signal leans on this: the same noise seed draws the same relative noise for the same
+    # measured values, so it cancels in the difference and leaves the effect and the scatter.
+    def bulk(level: float) -> pd.DataFrame:
+        return pd.DataFrame(
+            {
+                "test": "shear_cell",
+                "normal_stress": [1000.0, 1000.0, 2000.0, 2000.0],
+                "P": 0.5,
+                "mu_psh": [level, level, level, level],
+                "mu_sh": [level] * 4,
+                "rho_b": [1500.0] * 4,
+            }
+        )
+
+    noise = {"mu_psh": 0.03, "mu_sh": 0.03, "rho_b": 0.01}
+    a = replicate_record(bulk(0.5), "a", noise, 101, "s")["shear_cell"]
+    b = replicate_record(bulk(0.6), "b", noise, 101, "s")["shear_cell"]
+    for x, y in zip(a, b, strict=True):
+        assert x["mu_psh"] / 0.5 == pytest.approx(y["mu_psh"] / 0.6, rel=1e-5)
+        assert x["rho_b"] == pytest.approx(y["rho_b"])

@@ -12,6 +12,7 @@ model's design, runs and surrogates are made once and copied into one study dire
 set, which then runs `snakemake discrepancy`."""
 
 import json
+import math
 import re
 from pathlib import Path
 
@@ -26,9 +27,11 @@ from demcal.discrepancy.validation_matrix import (
     AMBIGUOUS,
     NOT_EXPLAINED,
     NOTHING,
+    VISIBLE_SIGNAL,
     matrix_cases,
     prepare_base,
     run_case,
+    with_signal,
 )
 
 from ..liggghts.conftest import require_liggghts
@@ -233,6 +236,16 @@ def test_no_hidden_effect_names_none(studies):
     assert "Not run" in (studies["none"] / "results" / "discrepancy" / "ranking.md").read_text()
     # Nothing beyond Find was run.
     assert not (studies["none"] / "results" / "discrepancy" / "probes").exists()
+
+
+def test_hidden_cohesion_moves_the_liggghts_measurements(studies):
+    # The twin signal compares the two LIGGGHTS data sets (same drawn friction, insertion seeds
+    # and noise draws): the drawn cohesion moves them by more than their error, so naming it
+    # is a question of the method, not of the data.
+    rows = pd.DataFrame([json.loads((work / "row.json").read_text()) for work in studies.values()])
+    table = with_signal(rows, studies["none"].parent).set_index("hidden")
+    assert table.loc["cohesion", "signal"] >= VISIBLE_SIGNAL, table["signal"]
+    assert math.isnan(table.loc["none", "signal"])
 
 
 def test_cohesion_signature_weakens_with_stress(studies):
