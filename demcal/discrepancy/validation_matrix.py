@@ -12,7 +12,10 @@ The outcome of a study is what the workflow said: ``nothing missing``, the named
 ``not explained`` (something is missing but no candidate was named). The summary is a confusion
 matrix of hidden effect against outcome, with the naming accuracy over the catalogue rows, the
 false-alarm rate on the rows with nothing hidden, and for the outside effect whether the gap
-after a named proxy stays above the noise.
+after a named proxy stays above the noise. Two measures say whether a miss is the method's or
+the data's: the naming power at the truth (from the study's probe runs) and the twin signal
+(how far the effect moved the truth engine's measurements against the study with nothing
+hidden and the same seed).
 """
 
 from __future__ import annotations
@@ -87,8 +90,8 @@ GAP_COLUMNS = (
 #: Signal of a hidden effect (rms over the measured values of the difference to the
 #: nothing-hidden twin, in measurement sd; see :func:`twin_signal`) from which it counts as
 #: visible in the measurements. Two samples of one material differ by the replicate scatter of
-#: both, at most sqrt(2) sd in expectation, and an rms of 12 such differences exceeds 2 with
-#: less than 5 % probability.
+#: both, at most sqrt(2) sd in expectation, and the rms of 9 or more such differences exceeds 2
+#: with less than 5 % probability.
 VISIBLE_SIGNAL = 2.0
 #: Columns of the per-study table of the matrix report.
 REPORT_COLUMNS = (
@@ -350,8 +353,9 @@ def twin_signal(study: str | Path, twin: str | Path) -> float:
     float
         sqrt(mean(((y - y_twin) / sd)^2)) over the values both measured, sd the study's
         measurement sd (-); NaN when the studies' drawn parameters differ (not twins) or they
-        share no measured value. About 1 or less: the effect stays within the measurement
-        error, and no method can name it from these measurements.
+        share no measured value. Below :data:`VISIBLE_SIGNAL` the data do not show the effect
+        beyond what two samples of one material differ by; above it the effect is in the data,
+        though a change of the refitted parameters may still mimic it.
     """
     study, twin = Path(study), Path(twin)
     mine = yaml.safe_load((study / "truth.yaml").read_text())
