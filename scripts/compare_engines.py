@@ -11,8 +11,9 @@ Example::
     python scripts/compare_engines.py --config config/tiny.yaml --seeds 4 \
         --sets low middle cohesion --out results/engine_comparison/tiny
     python scripts/compare_engines.py --config config/tiny.yaml --seeds 6 --sets \
-        --set wet coefficientFriction=0.57 coefficientRollingFriction=0 \
-        cohesionEnergyDensity=5.6e4 --out results/engine_comparison/wet
+        --extra-set wet=coefficientFriction:0.57,coefficientRollingFriction:0,\
+coefficientRestitution:0.7,density:2800,cohesionEnergyDensity:5.6e4 \
+        --out results/engine_comparison/wet
 """
 
 from __future__ import annotations
@@ -30,11 +31,11 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from demcal.bulk.convergence import parse_parameter_set  # noqa: E402
 from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     collect_values,
     load_status,
-    parameter_set_from_words,
     plan_runs,
     run_jobs,
     select_parameter_sets,
@@ -82,17 +83,17 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         "--sets",
         nargs="*",
         default=["low", "middle", "cohesion"],
-        help="named parameter sets (low, middle, high, interlocking, cohesion; none: only --set)",
+        help="named parameter sets (low, middle, high, interlocking, cohesion; none with --sets "
+        "alone: only the --extra-set ones)",
     )
     parser.add_argument(
-        "--set",
-        dest="own_sets",
-        nargs="+",
+        "--extra-set",
         action="append",
         default=[],
-        metavar="WORD",
-        help="a set of your own, run after --sets: NAME key=value ... (parameters not given as "
-        "in the low set); repeat for more sets",
+        metavar="NAME=key:value,...",
+        help="a further parameter set, run after --sets (every contact parameter: "
+        "coefficientFriction, coefficientRollingFriction, coefficientRestitution, density; "
+        "optionally cohesionEnergyDensity, wallFriction); repeatable",
     )
     parser.add_argument(
         "--engines",
@@ -127,13 +128,15 @@ def main(argv: list[str] | None = None) -> int:
     settings = load_config(Path(args.config))
     try:
         sets = select_parameter_sets(args.sets, str(settings.get("profile", "tiny")))
-        for words in args.own_sets:
-            name, params = parameter_set_from_words(words)
+        for text in args.extra_set:
+            name, params = parse_parameter_set(text)
             if name in sets:
-                raise ValueError(f"set {name} is given twice")
+                raise ValueError(f"a set named {name} is already in the comparison")
             sets[name] = params
     except ValueError as exc:
-        raise SystemExit(str(exc)) from None
+        raise SystemExit(f"--sets / --extra-set: {exc}") from None
+    if not sets:
+        raise SystemExit("no parameter sets: name some with --sets or add one with --extra-set")
     names = set(args.engines) | set(args.compare)
     if any(e not in ENGINE_COMMANDS for e in names):
         raise SystemExit(f"engines must be among {sorted(ENGINE_COMMANDS)}")

@@ -25,7 +25,6 @@ from typing import Any
 import pandas as pd
 
 from demcal.bulk.values import extract
-from demcal.core.parameters import out_of_bounds, unknown_parameter
 from demcal.engine_io.run import run_deck
 from demcal.virtual_tests.deck import DECK_NAMES, render_case
 
@@ -35,7 +34,6 @@ __all__ = [
     "RunJob",
     "collect_values",
     "load_status",
-    "parameter_set_from_words",
     "parameter_sets",
     "plan_runs",
     "run_jobs",
@@ -136,50 +134,6 @@ def select_parameter_sets(names: Sequence[str], profile: str) -> dict[str, dict[
     if unknown:
         raise ValueError(f"unknown parameter sets {unknown}; choose from {sorted(available)}")
     return {name: available[name] for name in names}
-
-
-def parameter_set_from_words(words: Sequence[str]) -> tuple[str, dict[str, float]]:
-    """A parameter set of its own, from the words ``NAME key=value [key=value ...]``.
-
-    Parameters not given take the values of the ``low`` set (mu_s 0.3, mu_r 0.1, COR 0.6,
-    rho_p 2500 kg/m^3), so that a set names only what it changes.
-
-    Parameters
-    ----------
-    words : sequence of str
-        The set's name, then ``parameter=value`` pairs (case parameter names, SI units), e.g.
-        ``["wet", "coefficientFriction=0.57", "cohesionEnergyDensity=5.6e4"]``.
-
-    Returns
-    -------
-    tuple of (str, dict)
-        Name and contact parameters of the set.
-
-    Raises
-    ------
-    ValueError
-        No name, a word without ``=``, an unknown parameter (with the closest known name) or a
-        value that is not a number or lies outside the parameter's physical bounds.
-    """
-    if not words or "=" in words[0]:
-        raise ValueError(f"a set starts with its name, then key=value pairs; got {list(words)}")
-    name, params = words[0], dict(_BASE_SET)
-    for word in words[1:]:
-        key, sep, text = word.partition("=")
-        if not sep:
-            raise ValueError(f"set {name}: {word!r} is not key=value")
-        reason = unknown_parameter(key)
-        if reason is not None:
-            raise ValueError(f"set {name}: {key}: {reason}")
-        try:
-            value = float(text)
-        except ValueError:
-            raise ValueError(f"set {name}: {key} = {text!r} is not a number") from None
-        reason = out_of_bounds(key, value)
-        if reason is not None:
-            raise ValueError(f"set {name}: {reason}")
-        params[key] = value
-    return name, params
 
 
 @dataclass

@@ -11,7 +11,6 @@ import pytest
 from scipy import stats
 
 from demcal.bulk.engine_comparison import (
-    parameter_set_from_words,
     parameter_sets,
 )
 from demcal.bulk.engine_statistics import (
@@ -83,30 +82,3 @@ def test_parameter_sets_have_cohesion() -> None:
     assert sets["low"]["coefficientFriction"] == 0.3
     assert sets["high"]["coefficientFriction"] == 0.9
     assert parameter_sets("quick")["cohesion"]["cohesionEnergyDensity"] == 100000.0
-
-
-def test_own_set_from_words_overrides_the_low_set() -> None:
-    name, params = parameter_set_from_words(
-        ["wet", "coefficientFriction=0.57", "cohesionEnergyDensity=5.6e4"]
-    )
-    assert name == "wet"
-    assert params["coefficientFriction"] == 0.57
-    assert params["cohesionEnergyDensity"] == 56000.0
-    # What the set does not name comes from the low set.
-    assert params["coefficientRestitution"] == parameter_sets()["low"]["coefficientRestitution"]
-
-
-@pytest.mark.parametrize(
-    ("words", "message"),
-    [
-        ([], "starts with its name"),
-        (["coefficientFriction=0.5"], "starts with its name"),
-        (["s", "coefficientFriction"], "is not key=value"),
-        (["s", "coefficentFriction=0.5"], "did you mean coefficientFriction"),
-        (["s", "coefficientFriction=high"], "is not a number"),
-        (["s", "coefficientRestitution=1.5"], "coefficientRestitution = 1.5 is outside"),
-    ],
-)
-def test_own_set_errors_name_the_word(words: list[str], message: str) -> None:
-    with pytest.raises(ValueError, match=message):
-        parameter_set_from_words(words)
