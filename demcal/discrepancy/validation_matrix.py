@@ -64,6 +64,7 @@ __all__ = [
     "power_at",
     "prepare_base",
     "run_case",
+    "study_name",
     "study_outcome",
     "twin_signal",
     "with_signal",
@@ -139,7 +140,12 @@ class MatrixCase:
     @property
     def name(self) -> str:
         """Directory name of the study."""
-        return f"{self.label}_{self.truth_seed}"
+        return study_name(self.label, self.truth_seed)
+
+
+def study_name(label: str, truth_seed: int) -> str:
+    """Directory name of the study of a row label (``hidden`` in the matrix rows) and seed."""
+    return f"{label}_{int(truth_seed)}"
 
 
 def matrix_cases(specs: Sequence[str | Path], truths: int, first_seed: int) -> list[MatrixCase]:
@@ -383,16 +389,16 @@ def with_signal(rows: pd.DataFrame, out_dir: str | Path) -> pd.DataFrame:
     """The matrix rows with a ``signal`` column (:func:`twin_signal`) for every study that has
     a finished nothing-hidden twin in ``out_dir``; NaN for the others and the null studies."""
     out_dir = Path(out_dir)
+    # A row's ``hidden`` is its case label, which names the study directory.
     twins = {
-        int(r.truth_seed): out_dir / f"{r.hidden}_{int(r.truth_seed)}"
+        int(r.truth_seed): out_dir / study_name(r.hidden, r.truth_seed)
         for r in rows.itertuples()
         if r.kind == "nothing"
     }
     signal = []
     for r in rows.itertuples():
-        # A row's ``hidden`` is its case label, which names the study directory.
         twin = twins.get(int(r.truth_seed))
-        study = out_dir / f"{r.hidden}_{int(r.truth_seed)}"
+        study = out_dir / study_name(r.hidden, r.truth_seed)
         found = r.kind != "nothing" and twin is not None and study.is_dir()
         signal.append(twin_signal(study, twin) if found else math.nan)
     return rows.assign(signal=signal)
@@ -477,14 +483,10 @@ def matrix_scores(rows: pd.DataFrame) -> dict[str, Any]:
     outside, n_outside = share("outside")
     # Catalogue studies whose ranking ran, and of those the ones whose data could name the
     # hidden effect at its truth; the accuracy that any method could reach is on the latter.
-    power = rows["power_at_truth"] if "power_at_truth" in rows else pd.Series(math.nan, rows.index)
-    ranked = rows[(rows["kind"] == "catalogue") & power.notna()]
-    nameable = ranked[power.loc[ranked.index] >= UNNAMEABLE]
+    ranked, nameable = _catalogue_at_least(rows, "power_at_truth", UNNAMEABLE)
     # Catalogue studies whose hidden effect moved the measurements beyond their error, judged
     # on the truth engine's data against the nothing-hidden twin (no probe, no model).
-    signal = rows["signal"] if "signal" in rows else pd.Series(math.nan, rows.index)
-    measured = rows[(rows["kind"] == "catalogue") & signal.notna()]
-    visible = measured[signal.loc[measured.index] >= VISIBLE_SIGNAL]
+    measured, visible = _catalogue_at_least(rows, "signal", VISIBLE_SIGNAL)
     return {
         "naming_accuracy": accuracy,
         "catalogue_studies": n_catalogue,
@@ -500,6 +502,16 @@ def matrix_scores(rows: pd.DataFrame) -> dict[str, Any]:
         "outside_acceptable": outside,
         "outside_studies": n_outside,
     }
+
+
+def _catalogue_at_least(
+    rows: pd.DataFrame, column: str, threshold: float
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The catalogue rows with a value in ``column``, and those of them at ``threshold`` or
+    above (both empty when the column is missing)."""
+    values = rows[column] if column in rows else pd.Series(math.nan, rows.index)
+    known = rows[(rows["kind"] == "catalogue") & values.notna()]
+    return known, known[values.loc[known.index] >= threshold]
 
 
 def _confirmation_line(rows: pd.DataFrame) -> str:
