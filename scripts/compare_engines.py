@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from demcal.bulk.convergence import parse_parameter_set  # noqa: E402
+from demcal.bulk.convergence import add_parameter_sets  # noqa: E402
 from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     collect_values,
@@ -128,11 +128,7 @@ def main(argv: list[str] | None = None) -> int:
     settings = load_config(Path(args.config))
     try:
         sets = select_parameter_sets(args.sets, str(settings.get("profile", "tiny")))
-        for text in args.extra_set:
-            name, params = parse_parameter_set(text)
-            if name in sets:
-                raise ValueError(f"a set named {name} is already in the comparison")
-            sets[name] = params
+        sets = add_parameter_sets(sets, args.extra_set)
     except ValueError as exc:
         raise SystemExit(f"--sets / --extra-set: {exc}") from None
     if not sets:

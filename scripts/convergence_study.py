@@ -40,7 +40,7 @@ import pandas as pd  # noqa: E402
 from demcal.bulk.convergence import (  # noqa: E402
     FACTORS,
     Factor,
-    parse_parameter_set,
+    add_parameter_sets,
     plan_study,
     quantities_of,
     restrict_levels,
@@ -180,14 +180,10 @@ def main(argv: list[str] | None = None) -> int:
         sets = select_parameter_sets(args.sets, str(settings.get("profile", "quick")))
     except ValueError as exc:
         raise SystemExit(str(exc)) from None
-    for text in args.extra_set:
-        try:
-            name, params = parse_parameter_set(text)
-        except ValueError as exc:
-            raise SystemExit(f"--extra-set: {exc}") from None
-        if name in sets:
-            raise SystemExit(f"--extra-set: a set named {name} is already in the study")
-        sets[name] = params
+    try:
+        sets = add_parameter_sets(sets, args.extra_set)
+    except ValueError as exc:
+        raise SystemExit(f"--extra-set: {exc}") from None
     if not sets:
         raise SystemExit("no parameter sets: name some with --sets or add one with --extra-set")
     chosen = {name: FACTORS[name] for name in args.factors}

@@ -40,6 +40,7 @@ __all__ = [
     "FACTORS",
     "TOLERANCES",
     "Factor",
+    "add_parameter_sets",
     "parse_parameter_set",
     "plan_study",
     "quantities_of",
@@ -283,6 +284,25 @@ def parse_parameter_set(text: str) -> tuple[str, dict[str, float]]:
     if missing:
         raise ValueError(f"parameter set {name}: missing {', '.join(missing)}")
     return name, params
+
+
+def add_parameter_sets(
+    sets: Mapping[str, Mapping[str, float]], texts: Sequence[str]
+) -> dict[str, dict[str, float]]:
+    """``sets`` with the sets of :func:`parse_parameter_set` from ``texts`` added after them.
+
+    Raises
+    ------
+    ValueError
+        A text that does not parse (the message names the culprit), or a name already taken.
+    """
+    merged = {name: dict(params) for name, params in sets.items()}
+    for text in texts:
+        name, params = parse_parameter_set(text)
+        if name in merged:
+            raise ValueError(f"a set named {name} is already in the study")
+        merged[name] = params
+    return merged
 
 
 def _apply(settings: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:

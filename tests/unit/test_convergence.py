@@ -15,6 +15,7 @@ import pytest
 from demcal.bulk.convergence import (
     FACTORS,
     Factor,
+    add_parameter_sets,
     parse_parameter_set,
     plan_study,
     restrict_levels,
@@ -252,3 +253,14 @@ def test_restricted_levels_keep_their_order_and_the_most_refined_is_the_referenc
     assert summary.loc[14.0, "reference"] == 35.0 and summary.loc[9.0, "deviation"] == 0.0
     with pytest.raises(ValueError, match="not among its levels"):
         restrict_levels(FACTORS["aor_lift_time"], [3.0])
+
+
+def test_added_sets_come_after_the_named_ones_and_leave_them_alone() -> None:
+    named = {"low": {**MIDDLE, "coefficientFriction": 0.3}}
+    text = "wet=" + ",".join(f"{k}:{v}" for k, v in MIDDLE.items()) + ",cohesionEnergyDensity:5e4"
+    sets = add_parameter_sets(named, [text])
+    assert list(sets) == ["low", "wet"]
+    assert sets["wet"] == {**MIDDLE, "cohesionEnergyDensity": 50000.0}
+    assert list(named) == ["low"]
+    with pytest.raises(ValueError, match="a set named low is already in the study"):
+        add_parameter_sets(named, ["low=" + text.partition("=")[2]])
