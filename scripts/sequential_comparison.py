@@ -208,10 +208,7 @@ def main() -> None:
         tol = float(config["screening"]["tolerance"])
         # The driver owns its study directories: a lock left by an interrupted call goes.
         run_snakemake(work, args.cores, mdir / "sequential.log", "--unlock")
-        # Finished DEM runs are kept when the code changed since (a resumed comparison).
-        run_snakemake(
-            work, args.cores, mdir / "sequential.log", "sequential", "--rerun-triggers", "mtime"
-        )
+        run_snakemake(work, args.cores, mdir / "sequential.log", "sequential")
         rows += sequential_rows(work, material, truth, ranges, tol)
         rows.append(engine_truth_row(spec, base, mdir, experiment, args))
         previous = None
@@ -235,14 +232,7 @@ def main() -> None:
                 source = donor or previous
                 if source is not None:
                     reuse_cases(source, work)
-                run_snakemake(
-                    work,
-                    args.cores,
-                    log,
-                    "results/verification/verification.csv",
-                    "--rerun-triggers",
-                    "mtime",
-                )
+                run_snakemake(work, args.cores, log, "results/verification/verification.csv")
             rows.append(oneshot_row(work, material, one_config, truth))
             previous = work
         donor = previous
