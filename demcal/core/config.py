@@ -233,11 +233,37 @@ def _shear_cell_problems(config: Mapping[str, Any]) -> list[str]:
     return problems
 
 
+def _switched_off_problems(config: Mapping[str, Any]) -> list[str]:
+    """Design parameters that are varied although the contact model ignores them.
+
+    With ``material.rolling_friction: false`` the decks write no rolling-resistance model, so a
+    varied ``coefficientRollingFriction`` would spend DEM runs on an input without effect and
+    leave it unidentifiable in the screening.
+    """
+    if config.get("material", {}).get("rolling_friction", True):
+        return []
+    design = config.get("design", {})
+    name = "coefficientRollingFriction"
+    # A factorial design reads only its levels, the sampled kinds only ranges and choices.
+    keys = ("levels",) if design.get("kind") == "factorial" else ("ranges", "choices")
+    problems = []
+    for key in keys:
+        values = design.get(key, {}).get(name)
+        if isinstance(values, list) and len(set(values)) > 1:
+            problems.append(
+                f"design.{key}.{name}: varied, but material.rolling_friction is false (the "
+                f"contact model ignores it); hold it in design.fixed instead or switch "
+                f"rolling friction on"
+            )
+    return problems
+
+
 def validate_config(config: dict, source: str) -> dict:
     """Validate a workflow configuration (``config/*.yaml``) in place and return it.
 
     The schema first (filling defaults), then the contact-parameter names and values
-    (:func:`parameter_problems`) and the shear-cell keys that only work together.
+    (:func:`parameter_problems`), the shear-cell keys that only work together and design
+    parameters the contact model switches off.
 
     Raises
     ------
@@ -246,7 +272,7 @@ def validate_config(config: dict, source: str) -> dict:
     """
     validate(config, "config.schema.yaml", source)
     problems = parameter_problems(config) + _shear_cell_problems(config)
-    problems += _log_scale_problems(config)
+    problems += _log_scale_problems(config) + _switched_off_problems(config)
     if problems:
         lines = "\n  ".join(problems)
         raise ConfigError(f"{source}: invalid configuration:\n  {lines}")

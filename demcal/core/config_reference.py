@@ -56,6 +56,12 @@ config/config.yaml: invalid configuration:
   key 'engine.threads': 0 is less than the minimum of 1
 ```
 
+Checks across keys follow, at the same point: contact-parameter names (with a suggestion for a
+misspelt one) and their physical bounds; a varied sliding friction that reaches 0 (the
+surrogates take its logarithm); shear-cell keys that only work together; and a varied
+`coefficientRollingFriction` with `material.rolling_friction: false` (the contact model ignores
+it, so its runs would be spent on an input without effect).
+
 Run another configuration with
 `snakemake --cores all --force-use-threads --configfile config/tiny.yaml`.
 

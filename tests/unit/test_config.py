@@ -202,6 +202,32 @@ def test_sliding_friction_reaching_zero_is_refused_before_any_run():
     validate_config({"design": {"fixed": {"coefficientFriction": 0.0}}}, "x.yaml")
 
 
+def test_rolling_friction_varied_without_the_rolling_model_is_refused():
+    # The default design varies coefficientRollingFriction; with the model off it does nothing.
+    with pytest.raises(ConfigError) as err:
+        validate_config({"material": {"rolling_friction": False}}, "x.yaml")
+    lines = [line.strip() for line in str(err.value).splitlines()[1:]]
+    assert len(lines) == 1
+    assert lines[0].startswith("design.ranges.coefficientRollingFriction: varied, but ")
+    assert "material.rolling_friction is false" in lines[0]
+    factorial = {
+        "kind": "factorial",
+        "levels": {"coefficientFriction": [0.3, 0.6], "coefficientRollingFriction": [0.1, 0.4]},
+    }
+    with pytest.raises(ConfigError, match=r"design\.levels\.coefficientRollingFriction: varied"):
+        validate_config({"material": {"rolling_friction": False}, "design": factorial}, "x.yaml")
+    # Held at one value, or read by no design kind (a factorial design ignores the ranges),
+    # it is accepted; so is any range with the rolling model on.
+    fixed = {
+        "ranges": {"coefficientFriction": [0.1, 0.9]},
+        "fixed": {"coefficientRollingFriction": 0.0},
+    }
+    validate_config({"material": {"rolling_friction": False}, "design": fixed}, "x.yaml")
+    factorial["levels"]["coefficientRollingFriction"] = [0.0]
+    validate_config({"material": {"rolling_friction": False}, "design": factorial}, "x.yaml")
+    validate_config({"material": {"rolling_friction": True}}, "x.yaml")
+
+
 @pytest.mark.parametrize(
     ("low", "high", "valid"),
     [(0.06, 1.0, True), (0.05, 0.9, False), (0.5, 1.0000001, False)],
