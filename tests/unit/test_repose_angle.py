@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from demcal.virtual_tests.angle_of_repose.readout import angle_of_repose
+from demcal.virtual_tests.angle_of_repose.readout import NotAHeapError, angle_of_repose
 
 R_MIN, R_MAX = 0.35e-3, 0.8e-3  # particle radii, m (sinter-fines range)
 HEIGHTS = {25.0: 0.016, 35.0: 0.020, 45.0: 0.024}  # heap height per angle, m
@@ -106,11 +106,16 @@ def test_off_centre_cone_on_raised_plate() -> None:
     assert res.angle_deg == pytest.approx(angle, abs=1.0)
     assert np.all(np.abs(res.sector_angles_deg - angle) < 2.5)
     assert res.heap_height == pytest.approx(HEIGHTS[angle], abs=2 * R_MAX)
-    # The hull method ignores the centre; the sectors need it. About the origin, the
-    # sectors facing away from the heap see a much wider envelope.
-    wrong = angle_of_repose(pos, rad, (0.0, 0.0), base_z)
-    assert wrong.angle_deg == res.angle_deg
-    assert wrong.sector_spread_deg > 5 * res.sector_spread_deg
+    # The hull method ignores the centre; the sectors need it. About an axis 5 mm off, the
+    # sectors facing away from it see a wider envelope.
+    shifted = angle_of_repose(pos, rad, (centre[0] + 5e-3, centre[1]), base_z)
+    assert shifted.angle_deg == res.angle_deg
+    assert shifted.sector_spread_deg > 2 * res.sector_spread_deg
+    # About the origin, outside the heap, the sectors facing away see no flank at all; a pile
+    # this tall is still read (the hull does not need the centre).
+    outside = angle_of_repose(pos, rad, (0.0, 0.0), base_z)
+    assert outside.angle_deg == res.angle_deg
+    assert not np.all(outside.sector_angles_deg < 90.0)
 
 
 def test_asymmetric_heap_sector_angles() -> None:
@@ -175,3 +180,33 @@ def test_bad_input() -> None:
         angle_of_repose(pos, rad, (0.0, 0.0), 1.0)
     with pytest.raises(ValueError, match="n_slices"):
         angle_of_repose(pos, rad, (0.0, 0.0), 0.0, n_slices=2)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_particles_spread_over_the_plate_are_no_heap(seed: int) -> None:
+    # A layer on the plate and a sparse second one over the same disc, as spheres without
+    # rolling resistance leave them: the hull "angle" reads 55-75 deg, some sectors above 90.
+    rng = np.random.default_rng(seed)
+    radius = 1.5e-3
+
+    def layer(n: int, z: float) -> np.ndarray:
+        rho = 0.04 * np.sqrt(rng.random(n))
+        phi = rng.uniform(0.0, 2 * np.pi, n)
+        return np.column_stack([rho * np.cos(phi), rho * np.sin(phi), np.full(n, z)])
+
+    pos = np.vstack([layer(500, radius), layer(150, 2.6 * radius)])
+    with pytest.raises(NotAHeapError, match=r"no heap: .* 5\.4 mm \(1\.8 mean diameters\) high"):
+        angle_of_repose(pos, np.full(len(pos), radius), (0.0, 0.0), 0.0)
+
+
+def test_a_standing_column_reads_vertical() -> None:
+    # A cohesive bulk standing as a column after the lift: not a layer, its flank is vertical.
+    rng = np.random.default_rng(5)
+    radius, column_radius, height = 1.5e-3, 0.02, 0.06
+    n = 4000
+    rho = column_radius * np.sqrt(rng.random(n))
+    phi = rng.uniform(0.0, 2 * np.pi, n)
+    pos = np.column_stack([rho * np.cos(phi), rho * np.sin(phi), rng.uniform(0.0, height, n)])
+    res = angle_of_repose(pos, np.full(n, radius), (0.0, 0.0), 0.0)
+    assert res.angle_deg == pytest.approx(90.0, abs=3.0)
+    assert res.heap_height > 10 * 2 * radius

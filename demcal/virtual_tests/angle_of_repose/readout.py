@@ -18,6 +18,14 @@ slice-to-slice angles ``atan(h / (r_k - r_{k+1}))`` over the slices between thos
 and the angle of a least-squares line ``r*(z)`` over the same range. Because the outermost
 centres of a slice sit a roughly constant distance inside the free surface, that offset cancels
 in the differences.
+
+A heap's flank narrows upwards all round: the hull angle and every sector's angle lie strictly
+between 0 and 90 degrees. Particles spread over the plate a layer or two deep (spheres without
+rolling resistance, for example) give hull and sector "angles" anywhere up to 180 degrees; a
+pile lower than :data:`LAYER_DIAMETERS` mean particle diameters whose flank does not narrow
+all round is such a layer and raises :class:`NotAHeapError` rather than returning an angle. A
+cohesive bulk that stands as a column after the lift keeps its height; its vertical or
+bulging flank reads 90 degrees or a little more, the test's upper limit.
 """
 
 from __future__ import annotations
@@ -27,7 +35,16 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-__all__ = ["ReposeResult", "angle_of_repose"]
+__all__ = ["LAYER_DIAMETERS", "NotAHeapError", "ReposeResult", "angle_of_repose"]
+
+
+#: A pile lower than this many mean particle diameters whose flank does not narrow upwards all
+#: round is particles spread over the plate, not a heap (quick spread layers: 2.1-2.5).
+LAYER_DIAMETERS = 4.0
+
+
+class NotAHeapError(ValueError):
+    """The particles on the plate form no heap whose angle could be read."""
 
 
 @dataclass(frozen=True)
@@ -166,6 +183,9 @@ def angle_of_repose(
     ValueError
         Arrays of the wrong shape or with non-finite values, non-positive radii, too few
         slices or sectors, or fewer than ``3 * n_slices`` particles left after filtering.
+    NotAHeapError
+        For particles spread over the plate: a pile lower than :data:`LAYER_DIAMETERS` mean
+        particle diameters whose flank does not narrow upwards all round.
     """
     pos = _as_array(positions, "positions", (None, 3))
     n = pos.shape[0]
@@ -231,6 +251,18 @@ def angle_of_repose(
             for s in range(n_sectors)
         ]
     )
+
+    flanks = np.append(sector_angles, angle)
+    narrows = np.all((flanks > 0.0) & (flanks < 90.0))  # NaN (no flank there) is False
+    diameter = 2.0 * float(np.mean(rad))
+    if not narrows and height < LAYER_DIAMETERS * diameter:
+        shown = ", ".join(f"{a:.1f}" for a in sector_angles)
+        raise NotAHeapError(
+            f"no heap: particles spread over the plate, {height * 1e3:.1f} mm "
+            f"({height / diameter:.1f} mean diameters) high, and the pile does not narrow "
+            f"upwards all round (hull angle {angle:.1f} deg, sector angles {shown} deg; "
+            f"{pos.shape[0]} particles with {min_contacts}+ contacts)"
+        )
 
     mid = (slice_z >= z_low) & (slice_z <= z_high) & np.isfinite(slice_radii)
     pair = mid[:-1] & mid[1:]
