@@ -8,7 +8,11 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from demcal.virtual_tests.angle_of_repose.readout import NotAHeapError, angle_of_repose
+from demcal.virtual_tests.angle_of_repose.readout import (
+    LAYER_DIAMETERS,
+    NotAHeapError,
+    angle_of_repose,
+)
 
 R_MIN, R_MAX = 0.35e-3, 0.8e-3  # particle radii, m (sinter-fines range)
 HEIGHTS = {25.0: 0.016, 35.0: 0.020, 45.0: 0.024}  # heap height per angle, m
@@ -210,3 +214,14 @@ def test_a_standing_column_reads_vertical() -> None:
     res = angle_of_repose(pos, np.full(n, radius), (0.0, 0.0), 0.0)
     assert res.angle_deg == pytest.approx(90.0, abs=3.0)
     assert res.heap_height > 10 * 2 * radius
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_a_flat_heap_below_the_layer_height_is_read(seed: int) -> None:
+    # A low friction bulk: an 8-degree cone about three mean diameters high narrows upwards all
+    # round, so it is a heap although it is lower than LAYER_DIAMETERS.
+    pos, rad = pack_heap(_cone(8.0), 0.003, (0.0, 0.0), 0.0, seed=seed)
+    res = angle_of_repose(pos, rad, (0.0, 0.0), 0.0)
+    assert res.heap_height < LAYER_DIAMETERS * 2 * rad.mean()
+    assert res.angle_deg == pytest.approx(8.0, abs=1.0)
+    assert np.all(np.abs(res.sector_angles_deg - 8.0) < 1.5)
