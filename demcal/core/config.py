@@ -24,6 +24,14 @@ from demcal.core.parameters import LOG_SCALE_PARAMETERS, out_of_bounds, unknown_
 
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "workflow" / "schemas"
 
+#: Keys of the ``design`` section that each kind of design reads (the others are ignored).
+DESIGN_KEYS_BY_KIND: dict[str, tuple[str, ...]] = {
+    "factorial": ("kind", "levels", "fixed"),
+    "random": ("kind", "n", "seed", "ranges", "choices", "fixed"),
+    "lhs": ("kind", "n", "seed", "ranges", "choices", "fixed"),
+    "sobol": ("kind", "n", "seed", "ranges", "choices", "fixed"),
+}
+
 
 class ConfigError(ValueError):
     """A configuration file or value that does not match its schema."""
@@ -244,10 +252,9 @@ def _switched_off_problems(config: Mapping[str, Any]) -> list[str]:
         return []
     design = config.get("design", {})
     name = "coefficientRollingFriction"
-    # A factorial design reads only its levels, the sampled kinds only ranges and choices.
-    keys = ("levels",) if design.get("kind") == "factorial" else ("ranges", "choices")
+    read = DESIGN_KEYS_BY_KIND[design["kind"]]
     problems = []
-    for key in keys:
+    for key in (k for k in ("levels", "ranges", "choices") if k in read):
         values = design.get(key, {}).get(name)
         if isinstance(values, list) and len(set(values)) > 1:
             problems.append(

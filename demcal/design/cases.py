@@ -16,6 +16,7 @@ from typing import Any
 
 import pandas as pd
 
+from demcal.core.config import DESIGN_KEYS_BY_KIND
 from demcal.core.provenance import write_sidecar
 from demcal.design.build import build_design
 from demcal.design.table import CASE_ID_COLUMN, write_design_table
@@ -24,14 +25,6 @@ from demcal.design.table import case_ids as numbered_ids
 _SHEAR_KEY = re.compile(r"[A-Za-z0-9]+_s(?P<s>\d+)(_p(?P<p>\d+))?")
 # A replicate's number follows the design row's id, before any load suffix.
 _REPLICATE_PART = re.compile(r"_r(?P<r>[1-9]\d*)(?=_s\d|$)")
-
-# Keys of the design config section that each kind of design reads.
-_KEYS_BY_KIND = {
-    "factorial": ("kind", "levels", "fixed"),
-    "random": ("kind", "n", "seed", "ranges", "choices", "fixed"),
-    "lhs": ("kind", "n", "seed", "ranges", "choices", "fixed"),
-    "sobol": ("kind", "n", "seed", "ranges", "choices", "fixed"),
-}
 
 
 def design_replicates(config: Mapping[str, Any], test: str = "shear_cell") -> int:
@@ -90,7 +83,7 @@ def design_id(case_id: str) -> str:
 
 def design_spec(section: Mapping[str, Any]) -> dict[str, Any]:
     """Reduce the validated ``design`` config section to the keys its kind uses."""
-    keys = _KEYS_BY_KIND[section["kind"]]
+    keys = DESIGN_KEYS_BY_KIND[section["kind"]]
     return {k: section[k] for k in keys if k in section and section[k] != {}}
 
 
