@@ -1,8 +1,9 @@
 """Off-screen pictures of the virtual bulk tests from the engine's VTK output (pyvista).
 
 * :func:`heap_picture`: the settled heap of an angle-of-repose case seen from the side, with the
-  plate, the lifted tube and the measured slope (the cone through the slice radii a quarter of
-  the heap height below and above its middle) drawn in front of the heap.
+  plate and the measured slope (the cone through the slice radii a quarter of
+  the heap height below and above its middle) drawn in front of the heap; without a heap, what
+  is on the plate and why no angle was read.
 * :func:`shear_cell_picture`: the shear cell at the end of the first pre-shear, cut in half along
   the shear direction, particles coloured by speed (the shear zone shows), the walls at their
   positions of that moment (lower part offset, lid height from the print file).
@@ -12,6 +13,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +24,11 @@ from matplotlib.figure import Figure
 from demcal.bulk.values import MissingOutputError, extract, read_case_record
 from demcal.engine_io.fix_output import read_print_file
 from demcal.engine_io.vtk_file import read_vtk_particles
-from demcal.virtual_tests.angle_of_repose.readout import angle_of_repose
+from demcal.virtual_tests.angle_of_repose.readout import (
+    NotAHeapError,
+    ReposeResult,
+    angle_of_repose,
+)
 from demcal.virtual_tests.shear_cell.readout import (
     PHASE_PRE_SHEAR,
     PHASE_SHEAR,
@@ -35,6 +41,8 @@ pyvista.OFF_SCREEN = True
 __all__ = ["heap_picture", "mu_series_figure", "shear_cell_picture"]
 
 _WINDOW = (1400, 900)
+# Characters per line of a picture's caption at font size 10 in that window.
+_TEXT_WIDTH = 150
 # Vertical colour bar on the right, clear of the heap and the cell.
 _BAR = {
     "color": "black",
@@ -72,6 +80,10 @@ def _spheres(points: np.ndarray, radii: np.ndarray, scalars: np.ndarray, name: s
 def heap_picture(case_dir: Path, png: Path) -> Path:
     """Side view of the settled heap with the measured slope.
 
+    Where the readout finds no heap (:class:`NotAHeapError`: particles spread over the plate,
+    or too few left on it) the picture shows what is there, without a slope, and its caption
+    gives the readout's reason.
+
     Parameters
     ----------
     case_dir : Path
@@ -95,49 +107,43 @@ def heap_picture(case_dir: Path, png: Path) -> Path:
     vtk = read_vtk_particles(_existing(case_dir, files["vtk"]), arrays=["radius"])
     radii = vtk.arrays["radius"].reshape(-1)
     contacts = vtk.arrays.get("c_cn")
-    result = angle_of_repose(
-        vtk.points,
-        radii,
-        tuple(readout["centre_xy"]),
-        float(readout["base_z"]),
-        contacts=None if contacts is None else contacts.reshape(-1),
-        n_slices=int(readout["n_slices"]),
-        n_sectors=int(readout["n_sectors"]),
-        min_contacts=int(readout["min_contacts"]),
-    )
     base = float(readout["base_z"])
+    try:
+        result = angle_of_repose(
+            vtk.points,
+            radii,
+            tuple(readout["centre_xy"]),
+            base,
+            contacts=None if contacts is None else contacts.reshape(-1),
+            n_slices=int(readout["n_slices"]),
+            n_sectors=int(readout["n_sectors"]),
+            min_contacts=int(readout["min_contacts"]),
+        )
+    except NotAHeapError as exc:
+        # The user sees what the lift left instead: a layer, a few particles or a bare plate.
+        result, text = None, f"case {record['case_id']}: {exc}"
     plotter = pyvista.Plotter(off_screen=True, window_size=_WINDOW)
     plotter.set_background("white")
-    plotter.add_mesh(
-        _spheres(vtk.points, radii, vtk.points[:, 2] - base, "height (m)"),
-        scalars="height (m)",
-        cmap="viridis",
-        scalar_bar_args=_BAR | {"title": "height above plate (m)"},
-    )
+    if len(radii):
+        plotter.add_mesh(
+            _spheres(vtk.points, radii, vtk.points[:, 2] - base, "height (m)"),
+            scalars="height (m)",
+            cmap="viridis",
+            scalar_bar_args=_BAR | {"title": "height above plate (m)"},
+        )
     plate = pyvista.read(str(_existing(case_dir, files["plate"])))
     plotter.add_mesh(plate, color="lightgray", opacity=0.6)
-
-    # The measured cone: r(z) through (r_low, z_low) with slope angle aor, in front of the heap.
-    angle = np.radians(result.angle_deg)
-    ok = np.isfinite(result.slice_radii)
-    r_low = float(np.interp(result.z_low, result.slice_z[ok], result.slice_radii[ok]))
-    z_apex = result.z_low + r_low * np.tan(angle)
-    r_base = r_low + (result.z_low - base) / np.tan(angle)
     front = -1.05 * float(setup["plate_radius"])
-    for side in (-1.0, 1.0):
-        line = pyvista.Line((side * r_base, front, base), (0.0, front, z_apex))
-        plotter.add_mesh(line, color="red", line_width=4)
-    for z in (result.z_low, result.z_high):
-        r = float(np.interp(z, result.slice_z[ok], result.slice_radii[ok]))
-        plotter.add_mesh(pyvista.Line((-r, front, z), (r, front, z)), color="orange", line_width=2)
-    spread = result.sector_angles_deg[np.isfinite(result.sector_angles_deg)]
-    text = (
-        f"case {record['case_id']}: angle of repose {result.angle_deg:.1f} deg "
-        f"(slice mean {result.angle_mean_slices_deg:.1f}, sectors "
-        f"{spread.min():.1f}-{spread.max():.1f} deg), heap height "
-        f"{1e3 * result.heap_height:.1f} mm"
-    )
-    plotter.add_text(text, font_size=10, color="black")
+    if result is not None:
+        _draw_cone(plotter, result, base, front)
+        spread = result.sector_angles_deg[np.isfinite(result.sector_angles_deg)]
+        text = (
+            f"case {record['case_id']}: angle of repose {result.angle_deg:.1f} deg "
+            f"(slice mean {result.angle_mean_slices_deg:.1f}, sectors "
+            f"{spread.min():.1f}-{spread.max():.1f} deg), heap height "
+            f"{1e3 * result.heap_height:.1f} mm"
+        )
+    plotter.add_text(textwrap.fill(text, _TEXT_WIDTH), font_size=10, color="black")
     plotter.enable_parallel_projection()
     plotter.view_xz()
     width = float(setup["plate_radius"])
@@ -147,6 +153,22 @@ def heap_picture(case_dir: Path, png: Path) -> Path:
     plotter.screenshot(str(png))
     plotter.close()
     return png
+
+
+def _draw_cone(plotter: pyvista.Plotter, result: ReposeResult, base: float, front: float) -> None:
+    """The measured cone in front of the heap: r(z) through (r_low, z_low) at the slope angle
+    (red), and the hull radii at the two readout heights (orange); lengths in m."""
+    angle = np.radians(result.angle_deg)
+    ok = np.isfinite(result.slice_radii)
+    r_low = float(np.interp(result.z_low, result.slice_z[ok], result.slice_radii[ok]))
+    z_apex = result.z_low + r_low * np.tan(angle)
+    r_base = r_low + (result.z_low - base) / np.tan(angle)
+    for side in (-1.0, 1.0):
+        line = pyvista.Line((side * r_base, front, base), (0.0, front, z_apex))
+        plotter.add_mesh(line, color="red", line_width=4)
+    for z in (result.z_low, result.z_high):
+        r = float(np.interp(z, result.slice_z[ok], result.slice_radii[ok]))
+        plotter.add_mesh(pyvista.Line((-r, front, z), (r, front, z)), color="orange", line_width=2)
 
 
 def _state_at(table, step: int) -> tuple[float, float]:

@@ -42,6 +42,7 @@ BASE = {
     "density": 2500.0,
 }
 AOR_BASE = {**BASE, "coefficientRollingFriction": 0.2}
+SPREAD = {**AOR_BASE, "coefficientFriction": 0.7, "coefficientRollingFriction": 0.0}
 SEEDS = (7, 11, 12, 13)
 P_TRENDS = 0.8  # P < 1 for the shear-phase comparison
 # The quick profile's ring shear cell (6 particle diameters wide, 9 diameters of pre-shear
@@ -94,6 +95,8 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
         "aor_base": ("angle_of_repose", AOR_BASE, 7),
         "aor_mur": ("angle_of_repose", {**AOR_BASE, "coefficientRollingFriction": 0.8}, 7),
         "aor_mus": ("angle_of_repose", {**AOR_BASE, "coefficientFriction": 0.8}, 7),
+        # Spheres without rolling resistance spread over the plate: no heap.
+        "aor_spread": ("angle_of_repose", SPREAD, 7),
         **{
             f"shear_mus_{name}_seed{s}": (
                 "shear_cell",
@@ -292,6 +295,38 @@ def test_heap_picture_draws_the_measured_slope(runs: dict[str, Path], tmp_path: 
     assert ink(image)[top:base, : left - 20].mean() < 0.01
     assert ink(image)[150:750, 1200:1240].mean() > 0.5
     assert distinct_colours(image) > 1000
+
+
+def _particles(image: np.ndarray) -> np.ndarray:
+    """Pixels of the spheres (coloured by height): not grey like the plate and the text, not
+    the red and orange lines, left of the colour bar; bool array (height, 1200)."""
+    body = image[:, :1200]
+    coloured = np.ptp(body, axis=-1) > 0.15
+    return coloured & ~colour_mask(body, "red", 0.1) & ~colour_mask(body, "orange", 0.1)
+
+
+def test_heap_picture_without_a_heap_shows_the_layer_and_the_reason(
+    runs: dict[str, Path], tmp_path: Path
+) -> None:
+    from demcal.virtual_tests.angle_of_repose.readout import NotAHeapError
+    from demcal.virtual_tests.pictures import heap_picture
+
+    with pytest.raises(NotAHeapError, match="no heap: particles spread over the plate"):
+        extract("angle_of_repose", runs["aor_spread"])
+    spread = read_png(heap_picture(runs["aor_spread"], tmp_path / "spread.png"))
+    heap = read_png(heap_picture(runs["aor_base"], tmp_path / "heap.png"))
+    # No measured slope, but the particles: under the same camera a layer over the width of
+    # the heap of the same bed with rolling resistance (17.7 deg, 15.8 mm high), rising a third
+    # as high above the plate (5.4 mm; the plate at the heap's lowest pixels, the layer's lowest
+    # are particles falling past the plate's rim); the caption wraps onto more lines.
+    assert not colour_mask(spread, "red").any()
+    assert not colour_mask(spread, "orange").any()
+    s_top, _, s_left, s_right = bbox(_particles(spread))
+    h_top, plate, h_left, h_right = bbox(_particles(heap))
+    assert s_right - s_left > 0.9 * (h_right - h_left)
+    assert plate - s_top < (plate - h_top) / 2
+    caption, heap_caption = (np.flatnonzero(ink(im)[:100].any(axis=1)) for im in (spread, heap))
+    assert np.ptp(caption) > 1.5 * np.ptp(heap_caption)
 
 
 def test_shear_cell_picture_draws_lid_and_shear_plane(

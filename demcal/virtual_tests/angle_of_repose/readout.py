@@ -182,10 +182,12 @@ def angle_of_repose(
     ------
     ValueError
         Arrays of the wrong shape or with non-finite values, non-positive radii, too few
-        slices or sectors, or fewer than ``3 * n_slices`` particles left after filtering.
+        slices or sectors.
     NotAHeapError
-        For particles spread over the plate: a pile lower than :data:`LAYER_DIAMETERS` mean
-        particle diameters whose flank does not narrow upwards all round.
+        (a ValueError) Fewer than ``3 * n_slices`` particles left on the plate after
+        filtering, or particles spread over the plate: a pile lower than
+        :data:`LAYER_DIAMETERS` mean particle diameters whose flank does not narrow upwards
+        all round.
     """
     pos = _as_array(positions, "positions", (None, 3))
     n = pos.shape[0]
@@ -206,9 +208,9 @@ def angle_of_repose(
         keep &= cnt >= min_contacts
     pos, rad = pos[keep], rad[keep]
     if pos.shape[0] < 3 * n_slices:
-        raise ValueError(
-            f"only {pos.shape[0]} particles left after filtering; need at least {3 * n_slices} "
-            f"for {n_slices} slices"
+        raise NotAHeapError(
+            f"no heap: only {pos.shape[0]} particles left on the plate after filtering; need at "
+            f"least {3 * n_slices} for {n_slices} slices"
         )
 
     top = float(np.max(pos[:, 2] + rad))
