@@ -32,7 +32,11 @@ from demcal.identification.calibration import (
 )
 from demcal.identification.identify import mean_set_statement
 from demcal.identification.verification import verification_table
-from demcal.identification.verification_run import write_verification_table
+from demcal.identification.verification_run import (
+    dem_verdict,
+    mean_interval,
+    write_verification_table,
+)
 from tests.engine.conftest import engine_path
 
 ROOT_DIR = Path(__file__).resolve().parents[2]
@@ -623,6 +627,57 @@ def test_write_verification_table_lists_engines_and_failed_runs(tmp_path):
     assert "mu_psh (2029 Pa, P 1): no finished run" in verdicts[2] and "aor" not in verdicts[2]
     assert pd.read_csv(tmp_path / "v.csv").shape == table.shape
     assert "surrogate" not in table  # no identified-set record given
+
+
+def _heaps(mean: float, sd: float, n: int) -> np.ndarray:
+    """n angles (deg) with exactly this mean and sample standard deviation."""
+    z = np.random.default_rng(n).standard_normal(n)
+    z = (z - z.mean()) / z.std(ddof=1)
+    return mean + sd * z
+
+
+def test_mean_interval_is_the_student_t_interval():
+    # t(0.975, 8) = 2.306, t(0.975, 2) = 4.303: nine heaps of sd 1.47 deg give +-1.13 deg.
+    low, high = mean_interval(35.80, 1.47, 9)
+    assert (low, high) == pytest.approx((35.80 - 1.130, 35.80 + 1.130), abs=2e-3)
+    assert mean_interval(1717.0, 10.0, 3) == pytest.approx((1692.2, 1741.8), abs=0.1)
+    assert mean_interval(35.8, math.nan, 1) is None
+
+
+@pytest.mark.parametrize(
+    ("heaps", "start", "undecided"),
+    [
+        # The default study's nine verification heaps at the sinter fines' set (35.80 +- 1.47
+        # deg): 7.9 % low, but the 95 % interval 34.67-36.93 reaches the band's edge 36.91.
+        (_heaps(35.80, 1.47, 9), "**The DEM runs on configured miss 1 of the 2", True),
+        # Ninety heaps at 37.0 +- 1.8 deg: 4.8 % low, within, interval 36.62-37.38 across 36.91.
+        (_heaps(37.0, 1.8, 90), "The DEM runs on configured reproduce every", True),
+        # Twelve heaps at 34.0 +- 1.5 deg: 12.5 % low, interval 33.05-34.95, wholly outside.
+        (_heaps(34.0, 1.5, 12), "**The DEM runs on configured miss 1 of the 2", False),
+        # Nine heaps at 38.5 +- 1.5 deg: 0.9 % low, interval 37.35-39.65, wholly inside.
+        (_heaps(38.5, 1.5, 9), "The DEM runs on configured reproduce every", False),
+        # One heap: no interval, no undecided.
+        (np.array([36.9]), "**The DEM runs on configured miss 1 of the 2", False),
+    ],
+)
+def test_the_verdict_names_values_whose_interval_crosses_the_tolerance(heaps, start, undecided):
+    experiment = ROOT_DIR / "config" / "experiments" / "sinter_fines.yaml"
+    rows = [
+        {"test": "shear_cell", "normal_stress": 10070.0, "P": 1.0, "rho_b": r}
+        for r in (1707.0, 1717.0, 1727.0)
+    ]
+    rows += [{"test": "angle_of_repose", "aor": a} for a in heaps]
+    table = verification_table(
+        {"configured": pd.DataFrame(rows)}, load_experiment(experiment), 0.05
+    )
+    verdict = dem_verdict(table, "configured", 0.05)
+    assert verdict.startswith(start)
+    # rho_b: 1717 +- 10 over three runs, interval 1692-1742 inside the band 1672-1848.
+    assert ("Undecided at 95% confidence" in verdict) is undecided
+    assert "rho_b (10070 Pa, P 1) 1717 (" not in verdict
+    if undecided:
+        assert f"aor {heaps.mean():.4g} (95% interval of the mean of {heaps.size} runs" in verdict
+        assert "tolerance band 36.91-40.79)" in verdict
 
 
 def test_verification_table_shows_the_surrogates_at_the_verified_set(tmp_path):
