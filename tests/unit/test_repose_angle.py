@@ -180,10 +180,25 @@ def test_bad_input() -> None:
         angle_of_repose(pos, rad, (0.0, 0.0, 0.0), 0.0)
     with pytest.raises(ValueError, match="contacts"):
         angle_of_repose(pos, rad, (0.0, 0.0), 0.0, contacts=np.ones(3))
-    with pytest.raises(ValueError, match="particles left"):
-        angle_of_repose(pos, rad, (0.0, 0.0), 1.0)
     with pytest.raises(ValueError, match="n_slices"):
         angle_of_repose(pos, rad, (0.0, 0.0), 0.0, n_slices=2)
+
+
+def test_too_few_particles_on_the_plate_are_no_heap() -> None:
+    # All below the plate; then 100 on it rolling about with one contact each, 30 of them
+    # with two: 60 are needed for 20 slices.
+    rng = np.random.default_rng(3)
+    pos = np.column_stack([rng.uniform(-0.04, 0.04, (100, 2)), np.full(100, 1e-3)])
+    rad = np.full(100, 1e-3)
+    with pytest.raises(NotAHeapError, match="no heap: 0 of the 0 particles on the plate,"):
+        angle_of_repose(pos, rad, (0.0, 0.0), 1.0)
+    contacts = np.where(np.arange(100) < 30, 2, 1)
+    with pytest.raises(
+        NotAHeapError,
+        match=r"no heap: 30 of the 100 particles on the plate with 2\+ contacts, fewer than the "
+        r"60 that 20 slices need",
+    ):
+        angle_of_repose(pos, rad, (0.0, 0.0), 0.0, contacts=contacts)
 
 
 @pytest.mark.parametrize("seed", range(3))

@@ -201,6 +201,7 @@ def angle_of_repose(
         raise ValueError(f"n_sectors must be at least 1, got {n_sectors}")
 
     keep = pos[:, 2] >= base_z
+    on_plate = int(keep.sum())
     if contacts is not None:
         cnt = np.asarray(contacts)
         if cnt.shape != (n,):
@@ -208,9 +209,10 @@ def angle_of_repose(
         keep &= cnt >= min_contacts
     pos, rad = pos[keep], rad[keep]
     if pos.shape[0] < 3 * n_slices:
+        which = "" if contacts is None else f" with {min_contacts}+ contacts"
         raise NotAHeapError(
-            f"no heap: only {pos.shape[0]} particles left on the plate after filtering; need at "
-            f"least {3 * n_slices} for {n_slices} slices"
+            f"no heap: {pos.shape[0]} of the {on_plate} particles on the plate{which}, fewer "
+            f"than the {3 * n_slices} that {n_slices} slices need"
         )
 
     top = float(np.max(pos[:, 2] + rad))
