@@ -9,6 +9,11 @@ comparison is flagged although the engines agree in every mean) by ``alpha``. A 
 
 The same machinery compares two parameter sets on one engine (:func:`compare_groups`), which
 shows that a real difference (e.g. sliding friction 0.3 against 0.9) is detected.
+
+Beside each mean test the Brown-Forsythe test (Levene's test about the medians) asks whether the
+two samples scatter alike (``p_spread``). It is reported, not part of pass or fail: the engines
+must agree in the mean, and a handful of seeds per engine gives a spread test little power,
+but one engine scattering more from seed to seed would cost every study replicate runs.
 """
 
 from __future__ import annotations
@@ -23,7 +28,14 @@ from scipy import stats
 
 from demcal.bulk.engine_comparison import BULK_VALUES
 
-__all__ = ["Comparison", "compare_engines", "compare_groups", "markdown_table", "welch_test"]
+__all__ = [
+    "Comparison",
+    "compare_engines",
+    "compare_groups",
+    "markdown_table",
+    "spread_test",
+    "welch_test",
+]
 
 
 def welch_test(a: Sequence[float], b: Sequence[float]) -> float:
@@ -42,6 +54,22 @@ def welch_test(a: Sequence[float], b: Sequence[float]) -> float:
     return float(stats.ttest_ind(x, y, equal_var=False).pvalue)
 
 
+def spread_test(a: Sequence[float], b: Sequence[float]) -> float:
+    """Two-sided p-value of the Brown-Forsythe test of equal spread of ``a`` and ``b``.
+
+    Levene's test on the absolute deviations from each sample's median. NaN entries are
+    dropped. Two samples without scatter give 1; fewer than two values in a sample give NaN.
+    """
+    x = np.asarray(a, dtype=float)
+    y = np.asarray(b, dtype=float)
+    x, y = x[np.isfinite(x)], y[np.isfinite(y)]
+    if len(x) < 2 or len(y) < 2:
+        return math.nan
+    if np.ptp(x) == 0.0 and np.ptp(y) == 0.0:
+        return 1.0
+    return float(stats.levene(x, y, center="median").pvalue)
+
+
 @dataclass
 class Comparison:
     """Result of a family of Welch tests with a Bonferroni correction.
@@ -50,7 +78,8 @@ class Comparison:
     ----------
     table : pandas.DataFrame
         One row per comparison: ``set``, ``quantity``, ``n_a``, ``mean_a``, ``sd_a``, ``n_b``,
-        ``mean_b``, ``sd_b``, ``difference`` (mean_b - mean_a), ``p_value``, ``passed``.
+        ``mean_b``, ``sd_b``, ``difference`` (mean_b - mean_a), ``p_value``, ``passed`` and
+        ``p_spread`` (Brown-Forsythe, not part of ``passed``).
     alpha : float
         Family-wise significance level.
     per_test_alpha : float
@@ -118,6 +147,7 @@ def compare_groups(
                 "difference": (float(np.mean(y) - np.mean(x)) if len(x) and len(y) else math.nan),
                 "p_value": p,
                 "passed": bool(np.isfinite(p) and p >= per_test),
+                "p_spread": spread_test(x, y),
             }
         )
     return Comparison(pd.DataFrame(rows), float(alpha), per_test, labels)
@@ -175,26 +205,29 @@ def markdown_table(comparison: Comparison) -> str:
     """The comparison as a Markdown table, with the test and its levels in a line above.
 
     Columns: set, bulk value, n, mean and seed sd of each group, difference (b - a), p-value
-    and pass/fail. Units: rho_b in kg/m^3, aor in degrees, mu_psh and mu_sh dimensionless.
+    and pass/fail, and the p-value of equal spread. Units: rho_b in kg/m^3, aor in degrees,
+    mu_psh and mu_sh dimensionless.
     """
     a, b = comparison.labels
     m = len(comparison.table)
     head = (
         f"Welch's two-sample t-test per set and bulk value, Bonferroni over {m} comparisons: "
         f"family-wise alpha = {comparison.alpha:g}, per test p < {comparison.per_test_alpha:.2g} "
-        "is a significant difference (fail).\n\n"
+        "is a significant difference (fail). Beside it the Brown-Forsythe test of equal seed "
+        "scatter (p spread), reported only.\n\n"
     )
     lines = [
         f"| set | value | n {a} / {b} | mean {a} | sd {a} | mean {b} | sd {b} | "
-        f"difference {b} - {a} | p | result |",
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
+        f"difference {b} - {a} | p | result | p spread |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for r in comparison.table.itertuples():
         q = str(r.quantity)
         p = "-" if not np.isfinite(r.p_value) else f"{r.p_value:.2g}"
+        spread = "-" if not np.isfinite(r.p_spread) else f"{r.p_spread:.2g}"
         lines.append(
             f"| {r.set} | {q} | {r.n_a} / {r.n_b} | {_fmt(r.mean_a, q)} | {_fmt(r.sd_a, q)} | "
             f"{_fmt(r.mean_b, q)} | {_fmt(r.sd_b, q)} | {_fmt(r.difference, q)} | {p} | "
-            f"{'pass' if r.passed else 'FAIL'} |"
+            f"{'pass' if r.passed else 'FAIL'} | {spread} |"
         )
     return head + "\n".join(lines) + "\n"

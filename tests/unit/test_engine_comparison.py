@@ -17,6 +17,7 @@ from demcal.bulk.engine_statistics import (
     compare_engines,
     compare_groups,
     markdown_table,
+    spread_test,
     welch_test,
 )
 
@@ -47,6 +48,27 @@ def test_bonferroni_level_and_flagging() -> None:
     assert comparison.flagged["set"].tolist() == ["s2"]
     row = comparison.table.set_index("set").loc["s2"]
     assert row["difference"] == pytest.approx(np.mean(shifted[1]) - np.mean(shifted[0]))
+
+
+def test_spread_test_is_brown_forsythe_and_stays_out_of_pass_or_fail() -> None:
+    a, b = [36.3, 38.1, 34.6, 37.9, 35.2], [37.0, 36.2, 36.9, 37.4, 36.6]
+    expected = stats.levene(a, b, center="median").pvalue
+    assert spread_test(a, b) == pytest.approx(expected)
+    assert spread_test([1.0, 1.0], [2.0, 2.0]) == 1.0
+    assert math.isnan(spread_test([1.0], [1.0, 2.0]))
+    # Thirty heaps a side, the same mean, one side scattering three times as much: the means
+    # pass, the spread test sees it; with equal scatter it does not.
+    rng = np.random.default_rng(4)
+    narrow, wide, alike = (rng.normal(37.0, sd, 30) for sd in (0.6, 1.8, 0.6))
+    comparison = compare_groups(
+        {("wide", "aor"): (narrow, wide), ("alike", "aor"): (narrow, alike)}
+    )
+    rows = comparison.table.set_index("set")
+    assert comparison.all_passed
+    assert rows.loc["wide", "p_spread"] < 0.01 < 0.05 < rows.loc["alike", "p_spread"]
+    text = markdown_table(comparison)
+    assert "| result | p spread |" in text
+    assert f"| pass | {rows.loc['wide', 'p_spread']:.2g} |" in text
 
 
 def test_too_few_samples_fail() -> None:
