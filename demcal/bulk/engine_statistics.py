@@ -38,17 +38,24 @@ __all__ = [
 ]
 
 
+def _finite_samples(a: Sequence[float], b: Sequence[float]) -> tuple[np.ndarray, np.ndarray] | None:
+    """``a`` and ``b`` without NaN entries; None when either keeps fewer than two values."""
+    x = np.asarray(a, dtype=float)
+    y = np.asarray(b, dtype=float)
+    x, y = x[np.isfinite(x)], y[np.isfinite(y)]
+    return (x, y) if len(x) >= 2 and len(y) >= 2 else None
+
+
 def welch_test(a: Sequence[float], b: Sequence[float]) -> float:
     """Two-sided p-value of Welch's t-test of equal means of ``a`` and ``b``.
 
     NaN entries are dropped. Two samples without scatter give 1 for equal and 0 for different
     means; fewer than two values in a sample give NaN.
     """
-    x = np.asarray(a, dtype=float)
-    y = np.asarray(b, dtype=float)
-    x, y = x[np.isfinite(x)], y[np.isfinite(y)]
-    if len(x) < 2 or len(y) < 2:
+    samples = _finite_samples(a, b)
+    if samples is None:
         return math.nan
+    x, y = samples
     if np.ptp(x) == 0.0 and np.ptp(y) == 0.0:
         return 1.0 if x[0] == y[0] else 0.0
     return float(stats.ttest_ind(x, y, equal_var=False).pvalue)
@@ -60,11 +67,10 @@ def spread_test(a: Sequence[float], b: Sequence[float]) -> float:
     Levene's test on the absolute deviations from each sample's median. NaN entries are
     dropped. Two samples without scatter give 1; fewer than two values in a sample give NaN.
     """
-    x = np.asarray(a, dtype=float)
-    y = np.asarray(b, dtype=float)
-    x, y = x[np.isfinite(x)], y[np.isfinite(y)]
-    if len(x) < 2 or len(y) < 2:
+    samples = _finite_samples(a, b)
+    if samples is None:
         return math.nan
+    x, y = samples
     if np.ptp(x) == 0.0 and np.ptp(y) == 0.0:
         return 1.0
     return float(stats.levene(x, y, center="median").pvalue)
