@@ -133,13 +133,11 @@ def _undecided(row: Mapping[str, Any], engine: str, tolerance: float) -> str | N
     """The row's mean interval when it straddles an edge of the tolerance band, as text."""
     dem, _, _ = engine_columns(engine)
     sd, runs = scatter_columns(engine)
-    if pd.isna(row[dem]) or pd.isna(row[sd]):
-        return None
     interval = mean_interval(float(row[dem]), float(row[sd]), int(row[runs]))
     measured = float(row["measured"])
     band = sorted((measured * (1.0 - tolerance), measured * (1.0 + tolerance)))
     if interval is None or interval[1] < band[0] or interval[0] > band[1]:
-        return None  # one run, or the interval wholly outside the band
+        return None  # one run or no value, or the interval wholly outside the band
     if band[0] <= interval[0] and interval[1] <= band[1]:
         return None  # wholly inside
     return (
