@@ -129,8 +129,25 @@ def mean_interval(values_mean: float, sd: float, runs: int) -> tuple[float, floa
     return values_mean - half, values_mean + half
 
 
-def _undecided(row: Mapping[str, Any], engine: str, tolerance: float) -> str | None:
-    """The row's mean interval when it straddles an edge of the tolerance band, as text."""
+def undecided(row: Mapping[str, Any], engine: str, tolerance: float) -> str | None:
+    """The row's mean interval when it straddles an edge of the tolerance band, as text.
+
+    Parameters
+    ----------
+    row : mapping
+        One row of a verification table (``measured``, ``dem_<engine>``, ``dem_sd_<engine>``,
+        ``runs_<engine>``).
+    engine : str
+        The engine whose columns are read.
+    tolerance : float
+        The relative tolerance (e.g. 0.05).
+
+    Returns
+    -------
+    str or None
+        The value, its :data:`CONFIDENCE` interval and the tolerance band; None when the
+        interval lies wholly inside or wholly outside the band, or for fewer than two runs.
+    """
     dem, _, _ = engine_columns(engine)
     sd, runs = scatter_columns(engine)
     interval = mean_interval(float(row[dem]), float(row[sd]), int(row[runs]))
@@ -187,12 +204,12 @@ def dem_verdict(table: pd.DataFrame, engine: str, tolerance: float) -> str:
             f"{_condition(row)} {float(row[dem]):.4g}{spread} against {float(row['measured']):.4g}"
             f" ({float(row[deviation]):.1%})"
         )
-    undecided = [u for _, row in table.iterrows() if (u := _undecided(row, engine, tolerance))]
+    unsure = [u for _, row in table.iterrows() if (u := undecided(row, engine, tolerance))]
     tail = (
         f" Undecided at {CONFIDENCE:.0%} confidence, more replicate runs would tell: "
-        + "; ".join(undecided)
+        + "; ".join(unsure)
         + "."
-        if undecided
+        if unsure
         else ""
     )
     if not misses:

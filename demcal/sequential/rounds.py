@@ -16,6 +16,12 @@ Stopping rule: stop after round r when
 - round r + 1 would exceed ``sequential.max_rounds`` ("max_rounds"), or
 - the DEM runs so far plus those of one more round (its sets and a verification) would exceed
   ``sequential.budget`` ("budget").
+
+A verified round names the values whose replicate runs' mean is within the tolerance while the
+interval of that mean (``CONFIDENCE`` of :mod:`demcal.identification.verification_run`) crosses
+an edge of the band (``undecided``): the stop may rest on a lucky draw. They do not hold the
+study back: the next round would verify another set, so only more verification runs at this set
+decide them.
 """
 
 from __future__ import annotations
@@ -35,6 +41,7 @@ from demcal.design.cases import (
     verification_case_ids,
     with_replicates,
 )
+from demcal.identification.verification_run import CONFIDENCE, undecided
 
 #: Quantiles of the valid sets that bound the valid box per parameter.
 BOX_QUANTILES = (0.05, 0.95)
@@ -211,14 +218,17 @@ def round_record(
     dict
         ``round``, ``sets``, ``runs``, ``runs_total``, ``group``, ``n_valid``, ``box``,
         ``volume``, ``volume_change``, ``settled``, ``verification`` (per observable: dem,
-        measured, deviation), ``verified``, ``surrogates``, ``stop`` and ``reason``.
+        measured, deviation), ``verified``, ``undecided`` (labels of the values whose
+        verification is undecided, module docstring), ``surrogates``, ``stop`` and ``reason``.
     """
     seq = config["sequential"]
+    tol = float(config["screening"]["tolerance"])
     ranges = design_ranges(config)
     sets = len(round_bases(config, round_no))
     runs = sets * runs_per_set(config)
     checked: dict[str, dict[str, float]] = {}
     verified = False
+    unsure: list[str] = []
     if verification is not None and len(verification):
         runs += verification_runs(config)
         for _, row in verification.iterrows():
@@ -228,6 +238,11 @@ def round_record(
                 "deviation": float(row["deviation_configured"]),
             }
         verified = bool(verification["within_tolerance_configured"].all())
+        unsure = [
+            verification_label(row)
+            for _, row in verification.iterrows()
+            if undecided(row, "configured", tol)
+        ]
     total = runs + (int(previous["runs_total"]) if previous else 0)
     box = valid_box(valid, ranges) if valid is not None else {}
     volume = box_volume(box)
@@ -235,13 +250,18 @@ def round_record(
     change = abs(volume - before) / before if before > 0 else math.inf
     settled = bool(box) and change < float(seq["shrink_tolerance"])
     next_cost = int(seq["batch"]) * runs_per_set(config) + verification_runs(config)
-    tol = float(config["screening"]["tolerance"])
+    caveat = (
+        f"; undecided at {CONFIDENCE:.0%} confidence: {', '.join(unsure)} (more "
+        "verification runs at this set would tell)"
+        if verified and unsure
+        else ""
+    )
     if verified and settled:
         stop, reason = (
             True,
             (
                 f"verified: every measured value within {tol:.0%} by DEM and the valid box changed "
-                f"by {change:.0%} (< {float(seq['shrink_tolerance']):.0%})"
+                f"by {change:.0%} (< {float(seq['shrink_tolerance']):.0%}){caveat}"
             ),
         )
     elif round_no + 1 >= int(seq["max_rounds"]):
@@ -255,7 +275,10 @@ def round_record(
             ),
         )
     else:
-        stop, reason = False, ("verified, valid box still changing" if verified else "continue")
+        stop, reason = (
+            False,
+            (f"verified, valid box still changing{caveat}" if verified else "continue"),
+        )
     return {
         "round": round_no,
         "sets": sets,
@@ -269,6 +292,7 @@ def round_record(
         "settled": settled,
         "verification": checked,
         "verified": verified,
+        "undecided": unsure,
         "surrogates": {k: dict(v) for k, v in surrogates.items()},
         "stop": stop,
         "reason": reason,
@@ -289,6 +313,7 @@ def rounds_table(records: Sequence[Mapping[str, Any]]) -> pd.DataFrame:
             "box_volume": rec["volume"],
             "volume_change": rec["volume_change"],
             "verified": rec["verified"],
+            "undecided": ", ".join(rec.get("undecided", [])),
             "worst_deviation": max(
                 (v["deviation"] for v in rec["verification"].values()), default=math.nan
             ),

@@ -28,6 +28,7 @@ from demcal.sequential.rounds import (
     round_dataset,
     round_of_case,
     round_record,
+    rounds_table,
     runs_per_set,
     valid_box,
     verification_runs,
@@ -202,15 +203,19 @@ def test_valid_box_and_volume():
     assert box_volume({"a": [0.2, 0.6], "b": [0.0, 0.5]}) == pytest.approx(0.2)
 
 
-def _verification(within: bool) -> pd.DataFrame:
+def _verification(within: bool, dem: float | None = None, sd: float = 0.2) -> pd.DataFrame:
+    """An angle of 30 deg verified by 3 heaps, by default 30.5 (within 5 %) or 36.0 (not)."""
+    value = dem if dem is not None else (30.5 if within else 36.0)
     return pd.DataFrame(
         {
             "observable": ["aor"],
             "normal_stress": [math.nan],
             "P": [math.nan],
             "measured": [30.0],
-            "dem_configured": [30.5 if within else 36.0],
-            "deviation_configured": [0.017 if within else 0.2],
+            "dem_configured": [value],
+            "dem_sd_configured": [sd],
+            "runs_configured": [3],
+            "deviation_configured": [abs(value / 30.0 - 1.0)],
             "within_tolerance_configured": [within],
         }
     )
@@ -229,6 +234,14 @@ def test_stopping_rule(config):
     second = round_record(1, config, identified, valid, _verification(True), {}, first)
     assert second["runs_total"] == 24 + 9 + 6
     assert second["settled"] and second["stop"] and second["reason"].startswith("verified")
+    # 30.5 +- 0.2 over 3 heaps: 95 % interval 30.0-31.0, inside the band 28.5-31.5
+    assert second["undecided"] == [] and "undecided" not in second["reason"]
+    # 31.2 +- 1.0: within 5 % (4 %), but the interval 28.7-33.7 crosses 31.5; the stop stands
+    # (another round verifies another set) and says so
+    lucky = round_record(1, config, identified, valid, _verification(True, 31.2, 1.0), {}, first)
+    assert lucky["stop"] and lucky["undecided"] == ["aor"]
+    assert "undecided at 95% confidence: aor" in lucky["reason"]
+    assert rounds_table([first, lucky])["undecided"].tolist() == ["", "aor"]
     missed = round_record(1, config, identified, valid, _verification(False), {}, first)
     # a failed verification goes on until the budget: 39 + 15 > 60 would stop
     assert not missed["verified"] and not missed["stop"]
