@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 from scipy.stats import qmc
 
+from demcal.core.config import DESIGN_KEYS_BY_KIND
 from demcal.design.table import (
     CASE_ID_COLUMN,
     DesignSpecError,
@@ -43,7 +44,7 @@ __all__ = [
     "sobol_design",
 ]
 
-_KINDS = ("factorial", "random", "lhs", "sobol")
+_KINDS = tuple(DESIGN_KEYS_BY_KIND)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -272,11 +273,12 @@ def sobol_design(
 # ----------------------------------------------------------------------------------------------
 # dispatch from a configuration mapping
 
+#: Keys a spec may have: those of the configuration's ``design`` section, and for a sampled
+#: design ``integer`` (the parameters drawn as whole numbers, which only the discrepancy
+#: workflow's extended designs use).
 _ALLOWED_KEYS = {
-    "factorial": {"kind", "levels", "fixed"},
-    "random": {"kind", "ranges", "n", "seed", "fixed", "integer", "choices"},
-    "lhs": {"kind", "ranges", "n", "seed", "fixed", "integer", "choices"},
-    "sobol": {"kind", "ranges", "n", "seed", "fixed", "integer", "choices"},
+    kind: {*keys, *(() if kind == "factorial" else ("integer",))}
+    for kind, keys in DESIGN_KEYS_BY_KIND.items()
 }
 
 
