@@ -126,6 +126,15 @@ FACTORS: dict[str, Factor] = {
             "shear_cell.shear_speed",
         ),
         Factor(
+            "shear_inertial",
+            "shear_cell",
+            "stress whose inertial number every stress keeps (Pa; 0: one speed at every stress)",
+            # A deck above the reference stress shears sqrt(sigma / reference) times faster;
+            # the reference level (0) shears at shear_speed whatever the stress.
+            _levels("shear_cell.shear_speed_reference_stress", (1068.0, 2029.0, 0.0)),
+            "shear_cell.shear_speed_reference_stress",
+        ),
+        Factor(
             "shear_stiffness",
             "shear_cell",
             "Young's modulus / pre-shear stress",

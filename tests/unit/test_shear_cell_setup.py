@@ -218,6 +218,37 @@ def test_forces_speeds_and_durations() -> None:
     )
 
 
+def test_speed_keeps_the_inertial_number_of_the_reference_stress() -> None:
+    def deck(stress: float, reference: float):
+        cfg = settings(
+            youngs_modulus_per_stress=3000.0,
+            youngs_modulus_max=1.0e9,
+            shear_speed_reference_stress=reference,
+        )
+        dist = size_distribution(cfg["particles"])
+        case = {**CASE, "normal_stress": stress}
+        modulus = shear_cell_youngs_modulus(case, cfg["material"], cfg["shear_cell"])
+        mat = material_setup(case, cfg["material"], dist, modulus)
+        return shear_cell_setup(10.0, stress, dist, mat, cfg["shear_cell"], 7)
+
+    low, high = deck(1068.0, 1068.0), deck(10070.0, 1068.0)
+    assert low.shear_speed == pytest.approx(3.0e-3)
+    assert high.shear_speed == pytest.approx(3.0e-3 * math.sqrt(10070.0 / 1068.0))
+    assert high.inertial_number_min_stress == pytest.approx(low.inertial_number_min_stress)
+    # Modulus and speed both follow the stress: the time step shrinks as the speed grows, so
+    # the pre-shears and shears take the steps of the reference stress (to the rounding of
+    # the time step); one speed at every stress takes sqrt(10070 / 1068) = 3.07 times more.
+    sheared = [d.total_steps - d.fill_steps for d in (low, high, deck(10070.0, 0.0))]
+    assert sheared[1] / sheared[0] == pytest.approx(1.0, rel=0.05)
+    assert sheared[2] / sheared[1] == pytest.approx(math.sqrt(10070.0 / 1068.0), rel=1e-3)
+    # Below the reference stress the cell shears slower, and 0 leaves shear_speed alone.
+    assert deck(534.0, 1068.0).shear_speed == pytest.approx(3.0e-3 / math.sqrt(2.0), rel=1e-3)
+    assert deck(534.0, 0.0).shear_speed == pytest.approx(3.0e-3)
+    with pytest.raises(ConfigError, match="shear_speed_reference_stress"):
+        settings_checked = {"shear_cell": {"shear_speed_reference_stress": -1.0}}
+        validate_config(settings_checked, "t")
+
+
 def test_segments_are_contiguous_and_cover_the_run() -> None:
     s, _, _ = setup_for()
     segs = s.segments

@@ -35,10 +35,10 @@ compresses it.
 Schulze sequence
 ----------------
 The phases and cycles are laid out by :mod:`demcal.virtual_tests.shear_cell.schedule`. The
-lower part moves at ``shear_speed * r_ref`` per second; a pre-shear lasts
-``preshear_travel * R / v`` and a shear ``shear_travel_ratio`` of that (the authors' 0.1875 R and
-19/20). A case row with a ``P`` column runs that single cycle (one deck per load condition);
-otherwise all values of ``shear_cell.P`` follow each other in one deck.
+lower part moves at v = ``shear_speed * r_ref`` per second (times :func:`shear_speed_factor`);
+a pre-shear lasts ``preshear_travel * R / v`` and a shear ``shear_travel_ratio`` of that (the
+authors' 0.1875 R and 19/20). A case row with a ``P`` column runs that single cycle (one deck
+per load condition); otherwise all values of ``shear_cell.P`` follow each other in one deck.
 
 The time step and the material come from :mod:`demcal.particles.material`.
 """
@@ -67,6 +67,7 @@ __all__ = [
     "inertial_number",
     "shear_cell_setup",
     "shear_cell_youngs_modulus",
+    "shear_speed_factor",
 ]
 
 _get = config_values.required
@@ -92,6 +93,22 @@ def shear_cell_youngs_modulus(
         cap = float(_get(cell, "youngs_modulus_max", "shear_cell"))
         return min(ratio * float(case["normal_stress"]), cap)
     return float(_get(material, "youngsModulus", "material"))
+
+
+def shear_speed_factor(cell: Mapping[str, Any], normal_stress: float) -> float:
+    """Factor on ``shear_cell.shear_speed`` at a pre-shear stress, -.
+
+    With ``shear_cell.shear_speed_reference_stress`` (sigma_ref) positive the lower part moves
+    ``sqrt(sigma / sigma_ref)`` times faster at a pre-shear stress sigma, which keeps the
+    inertial number of the shear band (:func:`inertial_number`) that of sigma_ref at every
+    stress; with ``youngs_modulus_per_stress`` the stiffness number is also the same, so the
+    decks of different stresses differ only by gravity and all take the steps of sigma_ref.
+    Otherwise 1.
+    """
+    reference = float(_get(cell, "shear_speed_reference_stress", "shear_cell"))
+    if reference > 0.0:
+        return math.sqrt(float(normal_stress) / reference)
+    return 1.0
 
 
 def inertial_number(
@@ -392,7 +409,11 @@ def shear_cell_setup(
 
     dt = material.timestep
     skin = skin_factor * dist.min_radius
-    speed = _positive(_get(cell, "shear_speed", where), f"{where}.shear_speed") * r_ref
+    speed = (
+        _positive(_get(cell, "shear_speed", where), f"{where}.shear_speed")
+        * r_ref
+        * shear_speed_factor(cell, normal_stress)
+    )
     preshear_travel = _positive(_get(cell, "preshear_travel", where), f"{where}.preshear_travel")
     ratio = _positive(_get(cell, "shear_travel_ratio", where), f"{where}.shear_travel_ratio")
     t_psh = preshear_travel * radius / speed
