@@ -245,8 +245,7 @@ def test_speed_keeps_the_inertial_number_of_the_reference_stress() -> None:
     assert deck(534.0, 1068.0).shear_speed == pytest.approx(3.0e-3 / math.sqrt(2.0), rel=1e-3)
     assert deck(534.0, 0.0).shear_speed == pytest.approx(3.0e-3)
     with pytest.raises(ConfigError, match="shear_speed_reference_stress"):
-        settings_checked = {"shear_cell": {"shear_speed_reference_stress": -1.0}}
-        validate_config(settings_checked, "t")
+        validate_config({"shear_cell": {"shear_speed_reference_stress": -1.0}}, "t")
 
 
 def test_segments_are_contiguous_and_cover_the_run() -> None:
