@@ -37,9 +37,12 @@ def settings(**cell: object) -> dict:
 
 
 def setup_for(dCylDp: float = 10.0, stress: float = 2029.0, **cell: object):
+    """The deck's setup as the workflow renders it: the modulus follows the cell's settings."""
     cfg = settings(**cell)
     dist = size_distribution(cfg["particles"])
-    mat = material_setup(CASE, cfg["material"], dist)
+    case = {**CASE, "normal_stress": stress}
+    modulus = shear_cell_youngs_modulus(case, cfg["material"], cfg["shear_cell"])
+    mat = material_setup(case, cfg["material"], dist, modulus)
     return shear_cell_setup(dCylDp, stress, dist, mat, cfg["shear_cell"], 7), mat, dist
 
 
@@ -220,16 +223,12 @@ def test_forces_speeds_and_durations() -> None:
 
 def test_speed_keeps_the_inertial_number_of_the_reference_stress() -> None:
     def deck(stress: float, reference: float):
-        cfg = settings(
+        return setup_for(
+            stress=stress,
             youngs_modulus_per_stress=3000.0,
             youngs_modulus_max=1.0e9,
             shear_speed_reference_stress=reference,
-        )
-        dist = size_distribution(cfg["particles"])
-        case = {**CASE, "normal_stress": stress}
-        modulus = shear_cell_youngs_modulus(case, cfg["material"], cfg["shear_cell"])
-        mat = material_setup(case, cfg["material"], dist, modulus)
-        return shear_cell_setup(10.0, stress, dist, mat, cfg["shear_cell"], 7)
+        )[0]
 
     low, high = deck(1068.0, 1068.0), deck(10070.0, 1068.0)
     assert low.shear_speed == pytest.approx(3.0e-3)
