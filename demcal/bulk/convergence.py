@@ -135,6 +135,15 @@ FACTORS: dict[str, Factor] = {
             "shear_cell.shear_speed_reference_stress",
         ),
         Factor(
+            "shear_travel",
+            "shear_cell",
+            "pre-shear travel (outer radii R; the shear travels 19/20 of it)",
+            # From a freshly compressed bed: does one pre-shear reach the steady state? In the
+            # quick ring 0.75 R is 9 particle diameters along the mean circle.
+            _levels("shear_cell.preshear_travel", (0.375, 0.75, 1.5)),
+            "shear_cell.preshear_travel",
+        ),
+        Factor(
             "shear_stiffness",
             "shear_cell",
             "Young's modulus / pre-shear stress",

@@ -292,6 +292,42 @@ def test_alternate_mode_swings_symmetrically() -> None:
     assert position.phase == 0 and position.moving and position.velocity > 0
 
 
+def test_run_in_lengthens_the_first_preshear_only() -> None:
+    def preshears(deck) -> list[int]:
+        return [c.preshear_end_step - c.preshear_start_step for c in deck.cycles]
+
+    plain, _, _ = setup_for(cycles="return")
+    run_in, _, _ = setup_for(cycles="return", run_in_travel=0.375)
+    # 0.375 R at the shear speed, in whole steps, on top of the 0.1875 R of every pre-shear.
+    extra = steps_for(0.375 * run_in.radius / run_in.shear_speed, run_in.timestep)
+    assert preshears(run_in) == [preshears(plain)[0] + extra, *preshears(plain)[1:]]
+    assert extra * run_in.shear_speed * run_in.timestep == pytest.approx(
+        0.375 * run_in.radius, abs=run_in.shear_speed * run_in.timestep
+    )
+    assert run_in.total_steps == plain.total_steps + extra
+    assert run_in.snapshot_step == run_in.cycles[0].preshear_end_step
+
+
+def test_run_in_keeps_the_alternate_swing_symmetric() -> None:
+    plain, _, _ = setup_for(cycles="alternate")
+    s, _, _ = setup_for(cycles="alternate", run_in_travel=0.375)
+    step = 2 * s.shear_speed * s.timestep
+    h = -plain.cycles[0].offset_shear_end
+    # The first swing starts further out and ends where the plain one does.
+    assert s.cycles[0].offset_preshear_start == pytest.approx(h + 0.375 * s.radius, abs=step)
+    for plain_cycle, cycle in zip(plain.cycles, s.cycles, strict=True):
+        assert cycle.offset_shear_end == pytest.approx(plain_cycle.offset_shear_end, abs=step)
+    assert s.max_offset == pytest.approx(h + 0.375 * s.radius, abs=step)
+    assert s.flange_width > s.max_offset
+
+
+def test_negative_run_in_names_the_key() -> None:
+    with pytest.raises(ConfigError, match="run_in_travel"):
+        validate_config({"shear_cell": {"run_in_travel": -0.1}}, "t")
+    with pytest.raises(SetupError, match=r"shear_cell\.run_in_travel"):
+        setup_for(run_in_travel=-0.1)
+
+
 def test_single_load_condition_runs_one_cycle() -> None:
     s, _, _ = setup_for(P=[0.6])
     assert len(s.cycles) == 1 and s.cycles[0].P == 0.6

@@ -202,6 +202,7 @@ def schulze_schedule(
     compress_steps: int,
     preshear_steps: int,
     unload_steps: int,
+    run_in_steps: int = 0,
     shear_steps: int,
     speed: float,
     return_speed: float,
@@ -240,6 +241,10 @@ def schulze_schedule(
         First step after the filling.
     compress_steps, preshear_steps, unload_steps, shear_steps : int
         Steps of one compression, pre-shear, unloading and shear.
+    run_in_steps : int
+        Steps the first pre-shear runs longer than the others (its readout window lies at its
+        end): a freshly compressed bed reaches the steadily sheared state only after more
+        travel than a later cycle, which starts from the state the earlier ones left.
     speed : float
         Speed of the lower part during pre-shear and shear, m/s.
     return_speed : float
@@ -257,7 +262,9 @@ def schulze_schedule(
     line = Timeline(start_step, force, gains)
     line.add("phase 0: compress to the pre-shear load", 0, 0, force, compress_steps)
     if mode == "alternate":
-        n_pos = max(1, n_cycle_travel // 2)
+        # The run-in adds to the first swing only: start that much further out, so that the
+        # first cycle still ends at -h.
+        n_pos = max(1, n_cycle_travel // 2 + run_in_steps)
         line.add("phase 0: move the lower part to +h under load", 0, 0, force, n_pos, speed, dt)
     cycles = []
     for k, p in enumerate(p_values):
@@ -284,7 +291,7 @@ def schulze_schedule(
             1,
             k,
             force,
-            preshear_steps,
+            preshear_steps + (run_in_steps if k == 0 else 0),
             direction * speed,
             dt,
             snapshot=k == 0,

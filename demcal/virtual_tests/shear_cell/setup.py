@@ -449,6 +449,10 @@ def shear_cell_setup(
         _positive(_get(cell, "compress_time", where), f"{where}.compress_time") * t_psh, dt
     )
     n_psh = steps_for(t_psh, dt)
+    run_in = float(_get(cell, "run_in_travel", where))
+    if not (math.isfinite(run_in) and run_in >= 0.0):
+        raise SetupError(f"configuration: '{where}.run_in_travel' must be >= 0, got {run_in!r}")
+    n_run_in = steps_for(run_in * radius / speed, dt) if run_in > 0.0 else 0
     n_unload = steps_for(t_unload, dt)
     n_sh = steps_for(t_sh, dt)
     schedule = schulze_schedule(
@@ -459,6 +463,7 @@ def shear_cell_setup(
         start_step=fill_steps,
         compress_steps=compress_steps,
         preshear_steps=n_psh,
+        run_in_steps=n_run_in,
         unload_steps=n_unload,
         shear_steps=n_sh,
         speed=speed,
