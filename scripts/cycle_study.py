@@ -2,7 +2,7 @@
 
 Renders one deck per reference parameter set and seed in which every value of
 ``shear_cell.P`` runs as a cycle of one sample (as ``separate_runs: false`` does), runs them on
-the bundled engine and writes to ``--out``:
+the bundled engine (or LIGGGHTS, ``--engine liggghts``) and writes to ``--out``:
 
 * ``values.csv``: every cycle's readings;
 * ``cycles.md``: per cycle, the pre-shear friction and bulk density over their deck's mean and
@@ -69,6 +69,12 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     )
     parser.add_argument("--seeds", type=int, default=3, help="decks per set")
     parser.add_argument("--normal-stress", type=float, default=1068.0, help="pre-shear, Pa")
+    parser.add_argument(
+        "--engine",
+        choices=sorted(ENGINE_COMMANDS),
+        default="engine",
+        help="code that runs the decks (liggghts: LIGGGHTS 3.8, one rank)",
+    )
     parser.add_argument("--parallel", type=int, default=2, help="runs at a time")
     parser.add_argument("--out", default="results/cycles", help="output directory")
     parser.add_argument(
@@ -135,9 +141,10 @@ def main(argv: list[str] | None = None) -> int:
             sets,
             list(range(1, args.seeds + 1)),
             out / "cases",
-            ENGINE_COMMANDS["engine"],
+            ENGINE_COMMANDS[args.engine],
             args.normal_stress,
             render=not args.collect_only,
+            engine=args.engine,
         )
     except ValueError as exc:
         raise SystemExit(str(exc)) from None
@@ -150,7 +157,8 @@ def main(argv: list[str] | None = None) -> int:
         raise SystemExit(f"{out}: no finished deck")
     values.to_csv(out / "values.csv", index=False)
     header = (
-        f"Config {args.config} {' '.join(args.overrides)}, sets {', '.join(sets)}, seeds "
+        f"Config {args.config} {' '.join(args.overrides)}, {args.engine}, sets "
+        f"{', '.join(sets)}, seeds "
         f"1-{args.seeds}, {args.normal_stress:g} Pa, {values['deck'].nunique()} of {len(jobs)} "
         "decks finished."
     )

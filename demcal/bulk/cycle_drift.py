@@ -86,6 +86,7 @@ def plan_cycle_decks(
     command: str,
     normal_stress: float,
     render: bool = True,
+    engine: str = "engine",
 ) -> list[RunJob]:
     """Render one multi-cycle shear-cell deck per parameter set and seed.
 
@@ -105,6 +106,8 @@ def plan_cycle_decks(
         Pre-shear normal stress, Pa.
     render : bool
         Write the case directories of decks without a ``status.json``; False: only list them.
+    engine : str
+        Name of the code that runs ``command`` (``engine`` or ``liggghts``), kept with the job.
 
     Returns
     -------
@@ -127,7 +130,7 @@ def plan_cycle_decks(
                 cfg = copy.deepcopy(dict(settings))
                 cfg["seed"] = int(seed)
                 render_case("shear_cell", case, cfg, case_dir)
-            jobs.append(RunJob(set_name, "shear_cell", "engine", int(seed), case_dir, command))
+            jobs.append(RunJob(set_name, "shear_cell", engine, int(seed), case_dir, command))
     return jobs
 
 

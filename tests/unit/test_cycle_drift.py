@@ -77,6 +77,11 @@ def test_decks_run_every_value_of_P_as_a_cycle(tmp_path: Path) -> None:
     # The run-in doubles the first pre-shear (0.75 R more on 0.75 R) and no other.
     assert preshears[0] == pytest.approx(2 * preshears[1], abs=2)
     assert len(set(preshears[1:])) == 1
+    # The same decks for LIGGGHTS: only the command and the code's name differ.
+    ligg = plan_cycle_decks(
+        settings, {"mid": SET}, [1], tmp_path, "liggghts -in {deck}", 1068.0, engine="liggghts"
+    )
+    assert ligg[0].engine == "liggghts" and ligg[0].case_dir == jobs[0].case_dir
     settings["shear_cell"]["P"] = [0.6]
     with pytest.raises(ValueError, match="at least two values"):
         plan_cycle_decks(settings, {"mid": SET}, [1], tmp_path / "one", "x", 1068.0)
