@@ -157,7 +157,7 @@ def main(argv: list[str] | None = None) -> int:
         raise SystemExit(f"{out}: no finished deck")
     values.to_csv(out / "values.csv", index=False)
     header = (
-        f"Config {args.config} {' '.join(args.overrides)}, {args.engine}, sets "
+        f"Config {' '.join([args.config, *args.overrides])}, {args.engine}, sets "
         f"{', '.join(sets)}, seeds "
         f"1-{args.seeds}, {args.normal_stress:g} Pa, {values['deck'].nunique()} of {len(jobs)} "
         "decks finished."
