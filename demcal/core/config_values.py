@@ -28,6 +28,14 @@ def positive_value(value: Any, where: str) -> float:
     return x
 
 
+def non_negative_value(value: Any, where: str) -> float:
+    """``value`` as a finite float >= 0, else ``SetupError`` naming ``where``."""
+    x = float(value)
+    if not (math.isfinite(x) and x >= 0.0):
+        raise SetupError(f"configuration: '{where}' must be >= 0, got {value!r}")
+    return x
+
+
 def fraction_value(value: Any, where: str, low: float = 0.0, high: float = 1.0) -> float:
     """``value`` as a float in (low, high], else ``SetupError`` naming ``where``."""
     x = float(value)

@@ -383,6 +383,7 @@ def test_servo_speed_above_skin_limit_names_the_key() -> None:
         ({"cycles": "zigzag"}, r"shear_cell\.cycles"),
         ({"shear_plane": 1.5}, r"shear_cell\.shear_plane"),
         ({"servo_kp": 0.0, "servo_ki": 0.0, "servo_kd": 0.0}, "servo_kp"),
+        ({"overfill": -0.1}, r"shear_cell\.overfill' must be >= 0, got -0\.1"),
     ],
 )
 def test_bad_settings_name_the_key(cell: dict, key: str) -> None:
@@ -485,6 +486,7 @@ def test_split_cell_has_no_ring_fields() -> None:
         (24.0, {**RING, "ring_radius_ratio": 1.0}, "ring_radius_ratio"),
         (24.0, {**RING, "bar_height": 6.0}, "bar_height"),
         (24.0, {**RING, "n_bars": -1}, "n_bars"),
+        (24.0, {**RING, "bar_height": float("nan")}, "bar_height' must be >= 0"),
         (24.0, {**RING, "geometry": "box"}, "geometry"),
     ],
 )

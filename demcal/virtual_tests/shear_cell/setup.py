@@ -72,6 +72,7 @@ __all__ = [
 
 _get = config_values.required
 _positive = config_values.positive_value
+_non_negative = config_values.non_negative_value
 _fraction = config_values.fraction_value
 
 
@@ -374,9 +375,7 @@ def shear_cell_setup(
     phi_ins = _fraction(_get(cell, "insertion_fraction", where), f"{where}.insertion_fraction")
     shear_plane = _fraction(_get(cell, "shear_plane", where), f"{where}.shear_plane", high=0.9)
 
-    overfill = float(_get(cell, "overfill", where)) * radius
-    if not (math.isfinite(overfill) and overfill >= 0.0):
-        raise SetupError(f"configuration: '{where}.overfill' must be >= 0, got {overfill!r}")
+    overfill = _non_negative(_get(cell, "overfill", where), f"{where}.overfill") * radius
     # The cell is overfilled and scraped level at the fill height, as in the real test: a
     # poured bed has a conical top, which a flat lid would load on a few particles only.
     n_particles = round(
@@ -449,9 +448,7 @@ def shear_cell_setup(
         _positive(_get(cell, "compress_time", where), f"{where}.compress_time") * t_psh, dt
     )
     n_psh = steps_for(t_psh, dt)
-    run_in = float(_get(cell, "run_in_travel", where))
-    if not (math.isfinite(run_in) and run_in >= 0.0):
-        raise SetupError(f"configuration: '{where}.run_in_travel' must be >= 0, got {run_in!r}")
+    run_in = _non_negative(_get(cell, "run_in_travel", where), f"{where}.run_in_travel")
     n_run_in = steps_for(run_in * radius / speed, dt) if run_in > 0.0 else 0
     n_unload = steps_for(t_unload, dt)
     n_sh = steps_for(t_sh, dt)
@@ -649,9 +646,7 @@ def _ring_geometry(cell: Mapping[str, Any], radius: float, r_ref: float, r_max: 
     n_bars = int(_get(cell, "n_bars", where))
     if n_bars < 0:
         raise SetupError(f"configuration: '{where}.n_bars' must be >= 0, got {n_bars}")
-    bar_height = float(_get(cell, "bar_height", where)) * r_ref
-    if not (math.isfinite(bar_height) and bar_height >= 0.0):
-        raise SetupError(f"configuration: '{where}.bar_height' must be >= 0, got {bar_height!r}")
+    bar_height = _non_negative(_get(cell, "bar_height", where), f"{where}.bar_height") * r_ref
     return _Ring(
         inner_radius=inner,
         # Vertices of the inner polygon lie on R_i: a centre this far out cannot touch it.
