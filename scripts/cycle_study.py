@@ -34,14 +34,11 @@ import pandas as pd  # noqa: E402
 import yaml  # noqa: E402
 
 from demcal.bulk.convergence import add_parameter_sets  # noqa: E402
-from demcal.bulk.cycle_drift import (  # noqa: E402
-    collect_cycle_values,
-    cycle_table,
-    plan_cycle_decks,
-)
+from demcal.bulk.cycle_drift import collect_cycle_values, cycle_table  # noqa: E402
 from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     load_status,
+    plan_runs,
     run_jobs,
     select_parameter_sets,
 )
@@ -132,19 +129,23 @@ def main(argv: list[str] | None = None) -> int:
         print(markdown(table, None, f"Shear-cell decks of {args.dataset}"))
         return 0
     settings = apply_overrides(load_config(Path(args.config)), args.overrides, args.config)
+    if len(settings["shear_cell"]["P"]) < 2:
+        raise SystemExit("shear_cell.P: a deck with cycles needs at least two values of P")
     try:
         sets = select_parameter_sets(args.sets, str(settings.get("profile", "quick")))
         sets = add_parameter_sets(sets, args.extra_set)
         out = Path(args.out)
-        jobs = plan_cycle_decks(
+        # P=None: every value of shear_cell.P runs as a cycle of one deck.
+        jobs = plan_runs(
             settings,
             sets,
             list(range(1, args.seeds + 1)),
             out / "cases",
-            ENGINE_COMMANDS[args.engine],
-            args.normal_stress,
+            engines={args.engine: ENGINE_COMMANDS[args.engine]},
+            tests=("shear_cell",),
+            normal_stress=args.normal_stress,
+            P=None,
             render=not args.collect_only,
-            engine=args.engine,
         )
     except ValueError as exc:
         raise SystemExit(str(exc)) from None

@@ -5,25 +5,22 @@ cycle of one sample (``shear_cell.separate_runs: false``). Its pre-shears all ru
 stress, so their readings repeat one another only if the bed returns to one state after every
 cycle. :func:`cycle_table` measures whether it does, from the per-cycle columns that
 :func:`demcal.bulk.values.extract` writes (``mu_psh_cycle``, ``rho_b_cycle``, ``mu_sh``);
-:func:`plan_cycle_decks` and :func:`collect_cycle_values` render, and read back, such decks for
-reference parameter sets (``scripts/cycle_study.py``).
+:func:`collect_cycle_values` reads them back from decks that
+:func:`demcal.bulk.engine_comparison.plan_runs` rendered with ``P=None``
+(``scripts/cycle_study.py``).
 """
 
 from __future__ import annotations
 
-import copy
-from collections.abc import Mapping, Sequence
-from pathlib import Path
-from typing import Any
+from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 
 from demcal.bulk.engine_comparison import RunJob
 from demcal.bulk.values import extract
-from demcal.virtual_tests.deck import render_case
 
-__all__ = ["collect_cycle_values", "cycle_table", "plan_cycle_decks"]
+__all__ = ["collect_cycle_values", "cycle_table"]
 
 _COLUMNS = ("cycle", "P", "mu_psh_cycle", "rho_b_cycle", "mu_sh", "steady_psh")
 
@@ -76,62 +73,6 @@ def cycle_table(values: pd.DataFrame, deck: str = "case_id") -> pd.DataFrame:
         table[name] = grouped[name].mean()
         table[f"{name}_se"] = grouped[name].std() / np.sqrt(grouped[name].count())
     return table
-
-
-def plan_cycle_decks(
-    settings: Mapping[str, Any],
-    sets: Mapping[str, Mapping[str, float]],
-    seeds: Sequence[int],
-    out_dir: Path,
-    command: str,
-    normal_stress: float,
-    render: bool = True,
-    engine: str = "engine",
-) -> list[RunJob]:
-    """Render one multi-cycle shear-cell deck per parameter set and seed.
-
-    Parameters
-    ----------
-    settings : mapping
-        Validated configuration; every value of ``shear_cell.P`` becomes a cycle.
-    sets : mapping
-        Parameter set name -> contact parameters.
-    seeds : sequence of int
-        Insertion seeds, one deck each.
-    out_dir : Path
-        A deck goes to ``out_dir/<set>/seed<seed>``.
-    command : str
-        Engine command template (``{deck}`` is the deck file name).
-    normal_stress : float
-        Pre-shear normal stress, Pa.
-    render : bool
-        Write the case directories of decks without a ``status.json``; False: only list them.
-    engine : str
-        Name of the code that runs ``command`` (``engine`` or ``liggghts``), kept with the job.
-
-    Returns
-    -------
-    list of RunJob
-
-    Raises
-    ------
-    ValueError
-        When ``shear_cell.P`` has fewer than two values.
-    """
-    if len(settings["shear_cell"]["P"]) < 2:
-        raise ValueError("shear_cell.P: a deck with cycles needs at least two values of P")
-    jobs = []
-    for set_name, params in sets.items():
-        # No P in the case row: the deck runs all values of P as cycles.
-        case = {"case_id": set_name, **params, "normal_stress": float(normal_stress)}
-        for seed in seeds:
-            case_dir = Path(out_dir) / set_name / f"seed{seed}"
-            if render and not (case_dir / "status.json").is_file():
-                cfg = copy.deepcopy(dict(settings))
-                cfg["seed"] = int(seed)
-                render_case("shear_cell", case, cfg, case_dir)
-            jobs.append(RunJob(set_name, "shear_cell", engine, int(seed), case_dir, command))
-    return jobs
 
 
 def collect_cycle_values(jobs: Sequence[RunJob]) -> pd.DataFrame:

@@ -157,7 +157,7 @@ def plan_runs(
     engines: Mapping[str, str] | None = None,
     tests: Iterable[str] = ("shear_cell", "angle_of_repose"),
     normal_stress: float | None = None,
-    P: float = 0.8,
+    P: float | None = 0.8,
     render: bool = True,
 ) -> list[RunJob]:
     """Render every case of the comparison (the same deck per set, test and seed for each engine).
@@ -180,8 +180,9 @@ def plan_runs(
     normal_stress : float, optional
         Pre-shear normal stress (Pa) of the shear cell; default the first of
         ``settings["shear_cell"]["normal_stresses"]``.
-    P : float
-        Ratio of shear to pre-shear load of the single load condition run.
+    P : float or None
+        Ratio of shear to pre-shear load of the single load condition run; None: every value
+        of ``settings["shear_cell"]["P"]`` as a cycle of one deck.
     render : bool
         Write the case directories (False: only list them, e.g. to collect earlier runs with
         :func:`load_status`).
@@ -202,7 +203,9 @@ def plan_runs(
         for test in tests:
             case: dict[str, Any] = {"case_id": f"{set_name}", **params}
             if test == "shear_cell":
-                case.update(normal_stress=stress, P=float(P))
+                case["normal_stress"] = stress
+                if P is not None:
+                    case["P"] = float(P)
             for seed in seeds:
                 cfg = copy.deepcopy(dict(settings))
                 cfg["seed"] = int(seed)

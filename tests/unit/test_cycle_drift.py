@@ -11,7 +11,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from demcal.bulk.cycle_drift import cycle_table, plan_cycle_decks
+from demcal.bulk.cycle_drift import cycle_table
+from demcal.bulk.engine_comparison import plan_runs
 from demcal.core.config import load_config
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -64,11 +65,14 @@ def test_cycle_table_needs_decks_with_cycles() -> None:
         cycle_table(_decks([0.5]).drop(columns="rho_b_cycle"))
 
 
-def test_decks_run_every_value_of_P_as_a_cycle(tmp_path: Path) -> None:
+def test_decks_without_P_run_every_value_of_P_as_a_cycle(tmp_path: Path) -> None:
     settings = load_config(ROOT / "config" / "config.yaml")
     settings["shear_cell"]["run_in_travel"] = 0.75
-    jobs = plan_cycle_decks(settings, {"mid": SET}, [1, 2], tmp_path, "x -in {deck}", 1068.0)
-    assert [job.case_dir for job in jobs] == [tmp_path / "mid" / f"seed{s}" for s in (1, 2)]
+    engines = {"engine": "x -in {deck}", "liggghts": "liggghts -in {deck}"}
+    jobs = plan_runs(
+        settings, {"mid": SET}, [1], tmp_path, engines, ("shear_cell",), 1068.0, P=None
+    )
+    assert [job.engine for job in jobs] == ["engine", "liggghts"]
     record = json.loads((jobs[0].case_dir / "case.json").read_text())
     assert "P" not in record["case"] and record["case"]["normal_stress"] == 1068.0
     cycles = record["setup"]["cycles"]
@@ -77,14 +81,9 @@ def test_decks_run_every_value_of_P_as_a_cycle(tmp_path: Path) -> None:
     # The run-in doubles the first pre-shear (0.75 R more on 0.75 R) and no other.
     assert preshears[0] == pytest.approx(2 * preshears[1], abs=2)
     assert len(set(preshears[1:])) == 1
-    # The same decks for LIGGGHTS: only the command and the code's name differ.
-    ligg = plan_cycle_decks(
-        settings, {"mid": SET}, [1], tmp_path, "liggghts -in {deck}", 1068.0, engine="liggghts"
-    )
-    assert ligg[0].engine == "liggghts" and ligg[0].case_dir == jobs[0].case_dir
-    settings["shear_cell"]["P"] = [0.6]
-    with pytest.raises(ValueError, match="at least two values"):
-        plan_cycle_decks(settings, {"mid": SET}, [1], tmp_path / "one", "x", 1068.0)
+    # The same deck for both codes.
+    decks = [(job.case_dir / "in.shear_cell").read_text() for job in jobs]
+    assert decks[0] == decks[1]
 
 
 def _script(*args: str) -> subprocess.CompletedProcess:
@@ -100,6 +99,13 @@ def test_script_stops_on_a_misspelt_key_before_any_run(tmp_path: Path) -> None:
     out = tmp_path / "study"
     res = _script("--set", "shear_cell.run_in_trave=1", "--out", str(out))
     assert res.returncode != 0 and "run_in_trave" in res.stderr, res.stderr
+    assert not out.exists()
+
+
+def test_script_needs_two_values_of_P_before_any_run(tmp_path: Path) -> None:
+    out = tmp_path / "study"
+    res = _script("--set", "shear_cell.P=[0.6]", "--out", str(out))
+    assert res.returncode != 0 and "at least two values of P" in res.stderr, res.stderr
     assert not out.exists()
 
 
