@@ -13,6 +13,13 @@ the two cylinder sections, shrunk by ``margin`` from both walls, gives
 with ``A_m`` the overlap area of the shrunken circles (the area cancels in ``mu_plane``). Keeping
 away from the walls leaves out the particles pinched at the rims of the split, so the two
 readouts agree only when the wall effects are small.
+
+The ring cell turns about the z axis, so its shear force is azimuthal: :func:`ring_plane_stress`
+sums the torque ``T = sum (x F_y - y F_x)`` of the same forces about the axis, with the lever arm
+at the crossing point, over the contacts crossing inside the annulus ``R_i + margin <= r <=
+R - margin``, and takes the shear stress uniform over it as the wall readout does:
+``tau = 3 |T| / (2 pi (R_o^3 - R_in^3))`` and ``sigma = sum F_z / (pi (R_o^2 - R_in^2))`` with
+the shrunken radii ``R_in = R_i + margin`` and ``R_o = R - margin``.
 """
 
 from __future__ import annotations
@@ -25,7 +32,13 @@ import pandas as pd
 from demcal.engine_io.local_dump import read_local_dump
 from demcal.virtual_tests.shear_cell.readout import overlap_area
 
-__all__ = ["CONTACT_COLUMNS", "plane_stress", "plane_stress_series"]
+__all__ = [
+    "CONTACT_COLUMNS",
+    "plane_stress",
+    "plane_stress_series",
+    "plateau_comparison",
+    "ring_plane_stress",
+]
 
 #: The twelve columns of the shear deck's contact dump (``pos id force``).
 CONTACT_COLUMNS: tuple[str, ...] = (
@@ -65,34 +78,100 @@ def plane_stress(
     """
     if not 0.0 <= margin < radius:
         raise ValueError(f"margin must lie in [0, R = {radius}), got {margin}")
+    x, y, force = _crossings(contacts, z_shear)
+    inner = radius - margin
+    inside = (x**2 + y**2 <= inner**2) & ((x - travel) ** 2 + y**2 <= inner**2)
+    fx = float(np.sum(force[inside, 0]))
+    fz = float(np.sum(force[inside, 2]))
+    area = float(overlap_area(inner, travel))
+    return _stresses(int(inside.sum()), area, abs(fx) / area if area > 0.0 else np.nan, fz)
+
+
+def ring_plane_stress(
+    contacts: pd.DataFrame, z_shear: float, inner_radius: float, radius: float, margin: float
+) -> dict[str, float]:
+    """Shear and normal stress across the ring cell's shear plane from one snapshot of contacts.
+
+    Parameters
+    ----------
+    contacts : pandas.DataFrame
+        Shape (n_contacts, 12), columns :data:`CONTACT_COLUMNS` (m, N; ``f`` is the force on
+        particle 1 from particle 2).
+    z_shear : float
+        Height of the shear plane, m.
+    inner_radius, radius : float
+        Inner and outer radius of the annulus, R_i and R, m.
+    margin : float
+        Distance kept from both walls, m (``0 <= 2 margin < R - R_i``).
+
+    Returns
+    -------
+    dict
+        ``n`` (contacts counted), ``area`` (m^2, of the shrunken annulus), ``torque`` (N m,
+        about the cell axis, on the bulk above the plane), ``tau``, ``sigma`` (Pa) and ``mu``
+        (-); the stresses are NaN when no contact crosses the evaluated annulus.
+
+    Raises
+    ------
+    ValueError
+        ``margin`` negative or leaving no annulus.
+    """
+    if not (margin >= 0.0 and 2.0 * margin < radius - inner_radius):
+        raise ValueError(
+            f"margin must lie in [0, (R - R_i) / 2 = {(radius - inner_radius) / 2}), got {margin}"
+        )
+    x, y, force = _crossings(contacts, z_shear)
+    r_in, r_out = inner_radius + margin, radius - margin
+    reach2 = x**2 + y**2
+    inside = (reach2 >= r_in**2) & (reach2 <= r_out**2)
+    torque = float(np.sum(x[inside] * force[inside, 1] - y[inside] * force[inside, 0]))
+    fz = float(np.sum(force[inside, 2]))
+    area = float(np.pi * (r_out**2 - r_in**2))
+    tau = 3.0 * abs(torque) / (2.0 * np.pi * (r_out**3 - r_in**3))
+    return {**_stresses(int(inside.sum()), area, tau, fz), "torque": torque}
+
+
+def _crossings(contacts: pd.DataFrame, z_shear: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where the branch lines crossing ``z = z_shear`` pierce it, and the force on the upper one.
+
+    Returns
+    -------
+    x, y : numpy.ndarray
+        Shape (n_crossing,), the crossing points, m.
+    force : numpy.ndarray
+        Shape (n_crossing, 3), the force on the particle above the plane from the one below, N.
+    """
     z1 = contacts["z1"].to_numpy(dtype=np.float64)
     z2 = contacts["z2"].to_numpy(dtype=np.float64)
     crossing = (z1 - z_shear) * (z2 - z_shear) < 0.0
     z1, z2 = z1[crossing], z2[crossing]
     t = (z_shear - z2) / (z1 - z2)
-    x = contacts["x2"].to_numpy()[crossing] + t * (
-        contacts["x1"].to_numpy()[crossing] - contacts["x2"].to_numpy()[crossing]
-    )
-    y = contacts["y2"].to_numpy()[crossing] + t * (
-        contacts["y1"].to_numpy()[crossing] - contacts["y2"].to_numpy()[crossing]
-    )
-    inner = radius - margin
-    inside = (x**2 + y**2 <= inner**2) & ((x - travel) ** 2 + y**2 <= inner**2)
-    # Force on the upper particle from the lower one.
-    sign = np.where(z1 > z_shear, 1.0, -1.0)[inside]
-    fx = float(np.sum(sign * contacts["fx"].to_numpy()[crossing][inside]))
-    fz = float(np.sum(sign * contacts["fz"].to_numpy()[crossing][inside]))
-    area = float(overlap_area(inner, travel))
-    n = int(inside.sum())
+    at = {k: contacts[k].to_numpy(dtype=np.float64)[crossing] for k in ("x1", "y1", "x2", "y2")}
+    x = at["x2"] + t * (at["x1"] - at["x2"])
+    y = at["y2"] + t * (at["y1"] - at["y2"])
+    # The dump gives the force on particle 1; on the upper particle it is that or its opposite.
+    sign = np.where(z1 > z_shear, 1.0, -1.0)
+    force = sign[:, None] * contacts[["fx", "fy", "fz"]].to_numpy(dtype=np.float64)[crossing]
+    return x, y, force
+
+
+def _stresses(n: int, area: float, tau: float, normal: float) -> dict[str, float]:
+    """The result row of a plane: NaN stresses when no contact crosses the evaluated area."""
     if n == 0 or area <= 0.0:
         return {"n": n, "area": area, "tau": np.nan, "sigma": np.nan, "mu": np.nan}
-    return {"n": n, "area": area, "tau": abs(fx) / area, "sigma": fz / area, "mu": abs(fx) / fz}
+    sigma = normal / area
+    return {"n": n, "area": area, "tau": tau, "sigma": sigma, "mu": tau / sigma}
 
 
 def plane_stress_series(
-    dump: str | Path, table: pd.DataFrame, z_shear: float, radius: float, margin: float
+    dump: str | Path,
+    table: pd.DataFrame,
+    z_shear: float,
+    radius: float,
+    margin: float,
+    inner_radius: float | None = None,
 ) -> pd.DataFrame:
-    """:func:`plane_stress` for every snapshot of a contact dump.
+    """:func:`plane_stress` (or :func:`ring_plane_stress`) for every snapshot of a contact dump.
 
     Parameters
     ----------
@@ -104,12 +183,15 @@ def plane_stress_series(
         before it).
     z_shear, radius, margin : float
         As in :func:`plane_stress`, m.
+    inner_radius : float, optional
+        Inner radius R_i of the ring cell, m; None or 0 for the split cell.
 
     Returns
     -------
     pandas.DataFrame
         One row per snapshot: ``step``, ``time`` (s), ``phase``, ``cycle``, ``travel`` (m),
-        ``n``, ``area`` (m^2), ``tau``, ``sigma`` (Pa), ``mu`` (-).
+        ``n``, ``area`` (m^2), ``tau``, ``sigma`` (Pa), ``mu`` (-); for the ring also
+        ``torque`` (N m).
     """
     steps = table["step"].to_numpy(dtype=np.int64)
     rows = []
@@ -126,7 +208,52 @@ def plane_stress_series(
                 "phase": int(row["phase"]),
                 "cycle": int(row["cycle"]),
                 "travel": float(row["travel"]),
-                **plane_stress(contacts, z_shear, radius, float(row["travel"]), margin),
+                **(
+                    ring_plane_stress(contacts, z_shear, inner_radius, radius, margin)
+                    if inner_radius
+                    else plane_stress(contacts, z_shear, radius, float(row["travel"]), margin)
+                ),
             }
         )
+    return pd.DataFrame(rows)
+
+
+def plateau_comparison(plane: pd.DataFrame, values: pd.DataFrame) -> pd.DataFrame:
+    """The contacts' mu over each steady window of a deck beside the wall readout's.
+
+    Parameters
+    ----------
+    plane : pandas.DataFrame
+        The snapshots of :func:`plane_stress_series`.
+    values : pandas.DataFrame
+        The deck's shear-cell rows (:func:`demcal.bulk.values.extract`): ``cycle``, the windows
+        ``psh_t_start`` ... ``sh_t_end`` (s), ``mu_sh`` and the cycle's own pre-shear reading
+        ``mu_psh_cycle`` (``mu_psh`` is the deck's mean over its cycles).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cycle and phase: ``cycle``, ``phase`` (``psh`` or ``sh``), ``snapshots``
+        (in the window), ``mu_wall``, ``mu_plane`` (their mean) and ``mu_plane_sd`` (their
+        standard deviation), all mu dimensionless; NaN without a snapshot in the window.
+    """
+    rows = []
+    for _, row in values.iterrows():
+        in_cycle = plane[plane["cycle"] == row["cycle"]]
+        for phase, key, wall in ((1, "psh", "mu_psh_cycle"), (3, "sh", "mu_sh")):
+            window = in_cycle[
+                (in_cycle["phase"] == phase)
+                & (in_cycle["time"] >= row[f"{key}_t_start"])
+                & (in_cycle["time"] <= row[f"{key}_t_end"])
+            ]["mu"]
+            rows.append(
+                {
+                    "cycle": int(row["cycle"]),
+                    "phase": key,
+                    "snapshots": len(window),
+                    "mu_wall": float(row[wall]),
+                    "mu_plane": float(window.mean()) if len(window) else np.nan,
+                    "mu_plane_sd": float(window.std()) if len(window) > 1 else np.nan,
+                }
+            )
     return pd.DataFrame(rows)
