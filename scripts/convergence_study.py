@@ -9,8 +9,10 @@ every deck on the bundled engine and writes to ``--out``:
 * ``convergence.md``: the summary as tables, with the cheapest converged level per factor;
 * ``<factor>.png``: each bulk value against the factor, seed sd as error bars.
 
-Runs already finished in ``--out`` are not run again (delete a case directory to redo it), so
-an interrupted study continues where it stopped.
+``--set SECTION.KEY=VALUE`` overrides a configuration key for every deck (validated like the
+file), e.g. ``shear_cell.contact_snapshots=25`` for the readout cross-check
+(``scripts/readout_check.py``). Runs already finished in ``--out`` are not run again (delete a
+case directory to redo it), so an interrupted study continues where it stopped.
 
 Example::
 
@@ -53,13 +55,21 @@ from demcal.bulk.engine_comparison import (  # noqa: E402
     run_jobs,
     select_parameter_sets,
 )
-from demcal.core.config import load_config  # noqa: E402
+from demcal.core.config import ConfigError, load_config, with_overrides  # noqa: E402
 from demcal.core.parameters import PARAMETERS  # noqa: E402
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--config", default="config/config.yaml", help="configuration YAML")
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="SECTION.KEY=VALUE",
+        help="override a configuration key for every deck (VALUE read as YAML); repeatable",
+    )
     parser.add_argument("--factors", nargs="+", default=list(FACTORS), help="factors to vary")
     parser.add_argument(
         "--sets",
@@ -175,7 +185,10 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [f for f in args.factors if f not in FACTORS]
     if unknown:
         raise SystemExit(f"unknown factors {unknown}; choose from {sorted(FACTORS)}")
-    settings = load_config(Path(args.config))
+    try:
+        settings = with_overrides(load_config(Path(args.config)), args.overrides, args.config)
+    except ConfigError as exc:
+        raise SystemExit(str(exc)) from None
     try:
         sets = select_parameter_sets(args.sets, str(settings.get("profile", "quick")))
     except ValueError as exc:
@@ -231,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
             _plot(summary, factor.name, factor.label, out / f"{factor.name}.png")
     failed = values[values["status"] != "ok"].drop_duplicates(["factor", "level", "set", "seed"])
     header = (
-        f"Config {args.config}, sets "
+        f"Config {' '.join([args.config, *args.overrides])}, sets "
         + ", ".join(f"{name} {_set_text(params)}" for name, params in sets.items())
         + f", seeds {seeds}, shear cell at "
         f"{args.normal_stress:g} Pa and P = {args.P:g}; started {started:%Y-%m-%d %H:%M} UTC, "

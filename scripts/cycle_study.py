@@ -22,7 +22,6 @@ Example::
 from __future__ import annotations
 
 import argparse
-import copy
 import sys
 from pathlib import Path
 
@@ -31,7 +30,6 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 import pandas as pd  # noqa: E402
-import yaml  # noqa: E402
 
 from demcal.bulk.convergence import add_parameter_sets  # noqa: E402
 from demcal.bulk.cycle_drift import collect_cycle_values, cycle_table  # noqa: E402
@@ -42,7 +40,7 @@ from demcal.bulk.engine_comparison import (  # noqa: E402
     run_jobs,
     select_parameter_sets,
 )
-from demcal.core.config import ConfigError, load_config, validate_config  # noqa: E402
+from demcal.core.config import ConfigError, load_config, with_overrides  # noqa: E402
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
@@ -83,21 +81,6 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
-def apply_overrides(settings: dict, texts: list[str], source: str) -> dict:
-    """``settings`` with ``SECTION.KEY=VALUE`` overrides, validated again as a whole."""
-    cfg = copy.deepcopy(settings)
-    for text in texts:
-        key, sep, value = text.partition("=")
-        section, dot, name = key.partition(".")
-        if not (sep and dot and name):
-            raise SystemExit(f"--set {text!r}: expected SECTION.KEY=VALUE")
-        cfg.setdefault(section, {})[name] = yaml.safe_load(value)
-    try:
-        return validate_config(cfg, f"{source} with --set {' '.join(texts)}")
-    except ConfigError as exc:
-        raise SystemExit(str(exc)) from None
-
-
 def markdown(table: pd.DataFrame, values: pd.DataFrame | None, header: str) -> str:
     """The cycle table (and the deck means per set, when given) as Markdown."""
     lines = [header, "", "| cycle | P | decks | steady pre-shears | mu_psh / deck mean |"]
@@ -128,7 +111,10 @@ def main(argv: list[str] | None = None) -> int:
             raise SystemExit(f"{args.dataset}: {exc}") from None
         print(markdown(table, None, f"Shear-cell decks of {args.dataset}"))
         return 0
-    settings = apply_overrides(load_config(Path(args.config)), args.overrides, args.config)
+    try:
+        settings = with_overrides(load_config(Path(args.config)), args.overrides, args.config)
+    except ConfigError as exc:
+        raise SystemExit(str(exc)) from None
     if len(settings["shear_cell"]["P"]) < 2:
         raise SystemExit("shear_cell.P: a deck with cycles needs at least two values of P")
     try:

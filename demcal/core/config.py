@@ -303,3 +303,31 @@ def load_config(path: str | Path) -> dict:
     if not isinstance(data, dict):
         raise ConfigError(f"{path}: top level must be a mapping")
     return validate_config(data, str(path))
+
+
+def with_overrides(config: Mapping[str, Any], texts: list[str], source: str) -> dict:
+    """A validated configuration with ``SECTION.KEY=VALUE`` overrides applied.
+
+    Parameters
+    ----------
+    config : mapping
+        A validated configuration (left unchanged).
+    texts : list of str
+        Overrides such as ``shear_cell.contact_snapshots=25``; the value is read as YAML.
+    source : str
+        Where ``config`` came from, for the error message.
+
+    Raises
+    ------
+    ConfigError
+        An override not of the form ``SECTION.KEY=VALUE``, or a result the schema refuses (a
+        misspelt key, a wrong value), naming the overrides.
+    """
+    cfg = copy.deepcopy(dict(config))
+    for text in texts:
+        key, sep, value = text.partition("=")
+        section, dot, name = key.partition(".")
+        if not (sep and dot and name):
+            raise ConfigError(f"override {text!r}: expected SECTION.KEY=VALUE")
+        cfg.setdefault(section, {})[name] = yaml.safe_load(value)
+    return validate_config(cfg, f"{source} with --set {' '.join(texts)}")

@@ -12,6 +12,7 @@ from demcal.core.config import (
     load_schema,
     parameter_problems,
     validate_config,
+    with_overrides,
 )
 from demcal.core.parameters import (
     CASE_PARAMETERS,
@@ -421,3 +422,18 @@ def test_a_profile_reads_the_same_alone_and_merged_over_the_quick_profile(profil
     # and tests read the profile alone (load_config). Every key with an effect must agree.
     alone, merged = _alone_and_merged(profile)
     assert _differences(alone, merged) <= WITHOUT_EFFECT[profile]
+
+
+def test_overrides_are_validated_like_the_file():
+    base = load_config(ROOT / "config" / "config.yaml")
+    cfg = with_overrides(base, ["shear_cell.contact_snapshots=25", "shear_cell.P=[0.5, 1.0]"], "c")
+    assert cfg["shear_cell"]["contact_snapshots"] == 25
+    assert cfg["shear_cell"]["P"] == [0.5, 1.0]
+    # The configuration given stays as it was.
+    assert base["shear_cell"]["contact_snapshots"] == 0
+    with pytest.raises(ConfigError, match=r"c with --set shear_cell\.contact_snapshot=5"):
+        with_overrides(base, ["shear_cell.contact_snapshot=5"], "c")
+    with pytest.raises(ConfigError, match="contact_snapshots"):
+        with_overrides(base, ["shear_cell.contact_snapshots=-1"], "c")
+    with pytest.raises(ConfigError, match=r"expected SECTION\.KEY=VALUE"):
+        with_overrides(base, ["contact_snapshots=5"], "c")

@@ -219,6 +219,8 @@ def test_parse_parameter_set_names_what_is_wrong(text: str, message: str) -> Non
             ["--extra-set", "middle=" + ",".join(f"{k}:{v}" for k, v in MIDDLE.items())],
             "a set named middle is already in the study",
         ),
+        (["--set", "shear_cell.contact_snapshot=25"], "contact_snapshot"),
+        (["--set", "contact_snapshots=25"], "expected SECTION.KEY=VALUE"),
     ],
 )
 def test_convergence_script_stops_on_bad_sets_before_any_run(
