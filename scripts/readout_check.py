@@ -3,7 +3,11 @@
 For every case directory given (a deck rendered with ``shear_cell.contact_snapshots`` > 0 and
 run), sets the contacts' mu across the shear plane over each steady window beside the wall
 readout's (``demcal.bulk.plane_check``), prints the table and, with ``--out``, writes it as CSV.
-``--margin`` keeps that many largest-particle diameters away from the cell's walls.
+``--margin`` keeps that many largest-particle diameters away from the cell's walls. ``--bands N``
+(ring decks) also splits the plane into N bands of equal width and prints, per phase and band,
+the normal stress over the annulus's and the friction, averaged over decks and windows, beside
+the contacts' friction over the whole annulus and the torque readout (written to
+``<out>_bands.csv`` with ``--out``).
 
 Example::
 
@@ -23,7 +27,7 @@ if str(ROOT) not in sys.path:
 
 import pandas as pd  # noqa: E402
 
-from demcal.bulk.plane_check import plane_check  # noqa: E402
+from demcal.bulk.plane_check import band_check, plane_check  # noqa: E402
 from demcal.bulk.values import MissingOutputError, read_case_record  # noqa: E402
 
 
@@ -36,21 +40,29 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
         default=0.0,
         help="distance kept from the walls, in largest-particle diameters",
     )
+    parser.add_argument(
+        "--bands", type=int, default=0, help="ring decks: bands of equal width (0: none)"
+    )
     parser.add_argument("--out", type=Path, help="CSV of every deck's windows")
     args = parser.parse_args(argv)
     if not args.margin >= 0.0:
         parser.error(f"--margin must be >= 0, got {args.margin}")
+    if args.bands < 0:
+        parser.error(f"--bands must be >= 0, got {args.bands}")
     return args
 
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
-    tables = []
+    tables, profiles = [], []
     for case_dir in args.case_dirs:
         try:
             record = read_case_record(case_dir)
             margin = 2.0 * float(record["particles"]["max_radius"]) * args.margin
             table = plane_check(case_dir, margin)
+            if args.bands:
+                profile = band_check(case_dir, args.bands)
+                profiles.append(profile.assign(case_dir=str(case_dir)))
         except (MissingOutputError, ValueError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
@@ -65,9 +77,18 @@ def main(argv: list[str] | None = None) -> int:
         f"\nplane / wall over {len(ratio)} windows: median {ratio.median():.4f}, "
         f"range {ratio.min():.4f}-{ratio.max():.4f}"
     )
+    if profiles:
+        bands = pd.concat(profiles, ignore_index=True)
+        mean = bands.groupby(["phase", "band"])[
+            ["r_lo", "r_hi", "sigma_rel", "mu", "mu_annulus", "mu_wall"]
+        ].mean()
+        print(f"\nbands (means over {bands['case_dir'].nunique()} decks and their windows):")
+        print(mean.round(4).to_string())
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
         every.to_csv(args.out, index=False)
+        if profiles:
+            bands.to_csv(args.out.with_name(args.out.stem + "_bands.csv"), index=False)
     return 0
 
 

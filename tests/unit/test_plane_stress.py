@@ -8,8 +8,10 @@ import pytest
 
 from demcal.virtual_tests.shear_cell.plane_stress import (
     CONTACT_COLUMNS,
+    band_profile,
     plane_stress,
     plateau_comparison,
+    ring_band_forces,
     ring_plane_stress,
 )
 from demcal.virtual_tests.shear_cell.readout import overlap_area
@@ -165,3 +167,69 @@ def test_plateau_comparison_averages_the_snapshots_inside_each_window() -> None:
     assert got.loc[(1, "psh"), "mu_plane"] == pytest.approx(0.45)
     # No snapshot in cycle 1's shear window: NaN, not a reading from outside it.
     assert got.loc[(1, "sh"), "snapshots"] == 0 and np.isnan(got.loc[(1, "sh"), "mu_plane"])
+
+
+def test_band_forces_split_the_annulus_into_equal_widths() -> None:
+    d = 0.002
+    table = contacts(
+        [
+            # inner band (10-13.3 mm): r = 11 mm on +x, azimuthal force +0.2 N
+            (0.011, 0.0, Z + d / 2, 0.011, 0.0, Z - d / 2, 1, 2, 0, 0.0, 0.2, 1.0),
+            # outer band (16.7-20 mm): r = 18 mm on +y, particle 1 below: force on the upper
+            # one is (+0.3, 0, 2); along the azimuth at +y that is -0.3 N
+            (0.0, 0.018, Z - d / 2, 0.0, 0.018, Z + d / 2, 3, 4, 0, -0.3, 0.0, -2.0),
+            # outer wall exactly: the last band
+            (-0.02, 0.0, Z + d / 2, -0.02, 0.0, Z - d / 2, 5, 6, 0, 0.0, -0.1, 0.5),
+            # not across the plane
+            (0.015, 0.0, Z + d, 0.015, 0.0, Z + 2 * d, 7, 8, 0, 0.0, 9.0, 9.0),
+        ]
+    )
+    got = ring_band_forces(table, Z, R_I, R, bands=3)
+    assert got["azimuthal_force_0"] == pytest.approx(0.2)
+    assert got["normal_force_0"] == pytest.approx(1.0)
+    assert got["azimuthal_force_1"] == 0.0 and got["normal_force_1"] == 0.0
+    # At -x a force along -y points along the azimuth (+0.1 N).
+    assert got["azimuthal_force_2"] == pytest.approx(-0.3 + 0.1)
+    assert got["normal_force_2"] == pytest.approx(2.5)
+    with pytest.raises(ValueError, match="bands"):
+        ring_band_forces(table, Z, R_I, R, bands=0)
+
+
+def test_band_profile_sums_each_window_band_by_band() -> None:
+    bands = 2
+    edges = np.linspace(R_I, R, bands + 1)
+    area = np.pi * (edges[1:] ** 2 - edges[:-1] ** 2)
+    # Two snapshots in the pre-shear window, one outside it; normal force per band set so that
+    # the inner band carries 800 Pa and the outer 1200 Pa on average.
+    plane = pd.DataFrame(
+        {
+            "cycle": [0, 0, 0],
+            "phase": [1, 1, 1],
+            "time": [0.2, 0.3, 0.05],
+            "normal_force_0": [700.0 * area[0], 900.0 * area[0], 1.0],
+            "normal_force_1": [1200.0 * area[1], 1200.0 * area[1], 1.0],
+            "azimuthal_force_0": [-0.3 * 700 * area[0], -0.3 * 900 * area[0], 5.0],
+            "azimuthal_force_1": [-0.5 * 1200 * area[1], -0.5 * 1200 * area[1], 5.0],
+        }
+    )
+    values = pd.DataFrame(
+        {
+            "cycle": [0],
+            "psh_t_start": [0.1],
+            "psh_t_end": [0.4],
+            "sh_t_start": [np.nan],
+            "sh_t_end": [np.nan],
+            "mu_psh_cycle": [0.45],
+            "mu_sh": [np.nan],
+        }
+    )
+    got = band_profile(plane, values, R_I, R, bands).set_index("band")
+    assert list(got["phase"]) == ["psh", "psh"]  # the shear has no window
+    assert got.loc[0, "sigma"] == pytest.approx(800.0)
+    assert got.loc[1, "sigma"] == pytest.approx(1200.0)
+    mean = (800.0 * area[0] + 1200.0 * area[1]) / area.sum()
+    assert got.loc[1, "sigma_rel"] == pytest.approx(1200.0 / mean)
+    assert got.loc[0, "mu"] == pytest.approx(0.3) and got.loc[1, "mu"] == pytest.approx(0.5)
+    annulus = (0.3 * 800.0 * area[0] + 0.5 * 1200.0 * area[1]) / (mean * area.sum())
+    assert got.loc[0, "mu_annulus"] == pytest.approx(annulus)
+    assert got.loc[0, "r_hi"] == pytest.approx(edges[1]) and got.loc[1, "mu_wall"] == 0.45

@@ -24,6 +24,7 @@ the shrunken radii ``R_in = R_i + margin`` and ``R_o = R - margin``.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -34,9 +35,11 @@ from demcal.virtual_tests.shear_cell.readout import overlap_area
 
 __all__ = [
     "CONTACT_COLUMNS",
+    "band_profile",
     "plane_stress",
     "plane_stress_series",
     "plateau_comparison",
+    "ring_band_forces",
     "ring_plane_stress",
 ]
 
@@ -131,6 +134,46 @@ def ring_plane_stress(
     return {**_stresses(int(inside.sum()), area, tau, fz), "torque": torque}
 
 
+def ring_band_forces(
+    contacts: pd.DataFrame, z_shear: float, inner_radius: float, radius: float, bands: int
+) -> dict[str, float]:
+    """Azimuthal and normal force across the ring's shear plane in bands of equal width.
+
+    Parameters
+    ----------
+    contacts : pandas.DataFrame
+        Shape (n_contacts, 12), columns :data:`CONTACT_COLUMNS` (m, N).
+    z_shear : float
+        Height of the shear plane, m.
+    inner_radius, radius : float
+        Inner and outer radius of the annulus, R_i and R, m.
+    bands : int
+        Number of bands between R_i and R (>= 1).
+
+    Returns
+    -------
+    dict
+        ``azimuthal_force_<k>`` and ``normal_force_<k>`` for k = 0 (innermost) ... bands - 1, N:
+        the sums over the contacts crossing the plane in band k of the force on the upper
+        particle along the azimuth (at the crossing point) and along z.
+    """
+    if bands < 1:
+        raise ValueError(f"bands must be >= 1, got {bands}")
+    x, y, force = _crossings(contacts, z_shear)
+    reach = np.hypot(x, y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        azimuthal = np.where(reach > 0.0, (x * force[:, 1] - y * force[:, 0]) / reach, 0.0)
+    edges = np.linspace(inner_radius, radius, bands + 1)
+    band = np.searchsorted(edges, reach, side="right") - 1
+    out: dict[str, float] = {}
+    for k in range(bands):
+        # The outer edge belongs to the last band.
+        inside = (band == k) | ((k == bands - 1) & (reach == radius))
+        out[f"azimuthal_force_{k}"] = float(np.sum(azimuthal[inside]))
+        out[f"normal_force_{k}"] = float(np.sum(force[inside, 2]))
+    return out
+
+
 def _crossings(contacts: pd.DataFrame, z_shear: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where the branch lines crossing ``z = z_shear`` pierce it, and the force on the upper one.
 
@@ -170,6 +213,7 @@ def plane_stress_series(
     radius: float,
     margin: float,
     inner_radius: float | None = None,
+    bands: int = 0,
 ) -> pd.DataFrame:
     """:func:`plane_stress` (or :func:`ring_plane_stress`) for every snapshot of a contact dump.
 
@@ -185,13 +229,15 @@ def plane_stress_series(
         As in :func:`plane_stress`, m.
     inner_radius : float, optional
         Inner radius R_i of the ring cell, m; None or 0 for the split cell.
+    bands : int
+        For the ring, also :func:`ring_band_forces` in this many bands (0: none).
 
     Returns
     -------
     pandas.DataFrame
         One row per snapshot: ``step``, ``time`` (s), ``phase``, ``cycle``, ``travel`` (m),
         ``n``, ``area`` (m^2), ``tau``, ``sigma`` (Pa), ``mu`` (-); for the ring also
-        ``torque`` (N m).
+        ``torque`` (N m) and, with ``bands``, the band forces (N).
     """
     steps = table["step"].to_numpy(dtype=np.int64)
     rows = []
@@ -213,9 +259,30 @@ def plane_stress_series(
                     if inner_radius
                     else plane_stress(contacts, z_shear, radius, float(row["travel"]), margin)
                 ),
+                **(
+                    ring_band_forces(contacts, z_shear, inner_radius, radius, bands)
+                    if inner_radius and bands
+                    else {}
+                ),
             }
         )
     return pd.DataFrame(rows)
+
+
+def _windows(
+    plane: pd.DataFrame, values: pd.DataFrame
+) -> Iterator[tuple[pd.Series, str, str, pd.DataFrame]]:
+    """The snapshots inside every steady window: (row of ``values``, ``psh`` or ``sh``, the
+    wall reading's column, snapshots)."""
+    for _, row in values.iterrows():
+        in_cycle = plane[plane["cycle"] == row["cycle"]]
+        for phase, key, wall in ((1, "psh", "mu_psh_cycle"), (3, "sh", "mu_sh")):
+            window = in_cycle[
+                (in_cycle["phase"] == phase)
+                & (in_cycle["time"] >= row[f"{key}_t_start"])
+                & (in_cycle["time"] <= row[f"{key}_t_end"])
+            ]
+            yield row, key, wall, window
 
 
 def plateau_comparison(plane: pd.DataFrame, values: pd.DataFrame) -> pd.DataFrame:
@@ -238,22 +305,72 @@ def plateau_comparison(plane: pd.DataFrame, values: pd.DataFrame) -> pd.DataFram
         standard deviation), all mu dimensionless; NaN without a snapshot in the window.
     """
     rows = []
-    for _, row in values.iterrows():
-        in_cycle = plane[plane["cycle"] == row["cycle"]]
-        for phase, key, wall in ((1, "psh", "mu_psh_cycle"), (3, "sh", "mu_sh")):
-            window = in_cycle[
-                (in_cycle["phase"] == phase)
-                & (in_cycle["time"] >= row[f"{key}_t_start"])
-                & (in_cycle["time"] <= row[f"{key}_t_end"])
-            ]["mu"]
+    for row, key, wall, window in _windows(plane, values):
+        mu = window["mu"]
+        rows.append(
+            {
+                "cycle": int(row["cycle"]),
+                "phase": key,
+                "snapshots": len(mu),
+                "mu_wall": float(row[wall]),
+                "mu_plane": float(mu.mean()) if len(mu) else np.nan,
+                "mu_plane_sd": float(mu.std()) if len(mu) > 1 else np.nan,
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def band_profile(
+    plane: pd.DataFrame, values: pd.DataFrame, inner_radius: float, radius: float, bands: int
+) -> pd.DataFrame:
+    """Normal stress and friction across the ring's shear plane band by band, per steady window.
+
+    The ring's readout takes the shear stress uniform over the annulus; this profile shows how
+    far it is.
+
+    Parameters
+    ----------
+    plane : pandas.DataFrame
+        The snapshots of :func:`plane_stress_series` with ``bands`` band forces.
+    values : pandas.DataFrame
+        The deck's shear-cell rows, as for :func:`plateau_comparison`.
+    inner_radius, radius : float
+        R_i and R, m.
+    bands : int
+        Number of bands in ``plane``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cycle, phase and band: ``cycle``, ``phase``, ``band`` (0 innermost),
+        ``r_lo``, ``r_hi`` (m), ``sigma`` (Pa, the band's mean normal stress over the window),
+        ``sigma_rel`` (over the whole annulus's), ``mu`` (sum of azimuthal over sum of normal
+        force in the band), ``mu_annulus`` (the same over the whole annulus: the contacts'
+        friction without the uniform-stress assumption) and ``mu_wall`` (the torque readout).
+    """
+    edges = np.linspace(inner_radius, radius, bands + 1)
+    area = np.pi * (edges[1:] ** 2 - edges[:-1] ** 2)
+    rows = []
+    for row, key, wall, window in _windows(plane, values):
+        if window.empty:
+            continue
+        azimuthal = np.array([window[f"azimuthal_force_{k}"].sum() for k in range(bands)])
+        normal = np.array([window[f"normal_force_{k}"].sum() for k in range(bands)])
+        sigma = normal / len(window) / area
+        mean_sigma = normal.sum() / len(window) / area.sum()
+        for k in range(bands):
             rows.append(
                 {
                     "cycle": int(row["cycle"]),
                     "phase": key,
-                    "snapshots": len(window),
+                    "band": k,
+                    "r_lo": float(edges[k]),
+                    "r_hi": float(edges[k + 1]),
+                    "sigma": float(sigma[k]),
+                    "sigma_rel": float(sigma[k] / mean_sigma),
+                    "mu": float(abs(azimuthal[k]) / normal[k]),
+                    "mu_annulus": float(abs(azimuthal.sum()) / normal.sum()),
                     "mu_wall": float(row[wall]),
-                    "mu_plane": float(window.mean()) if len(window) else np.nan,
-                    "mu_plane_sd": float(window.std()) if len(window) > 1 else np.nan,
                 }
             )
     return pd.DataFrame(rows)
