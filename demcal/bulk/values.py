@@ -162,9 +162,10 @@ def _preshear_point(values: pd.DataFrame) -> pd.DataFrame:
     """The pre-shear point of a deck's yield locus: mu_psh and rho_b as the means over the
     pre-shears of all its cycles.
 
-    Every cycle pre-shears at the same normal stress to the same steady state, so its readings
-    are repeated measurements of the yield locus's single pre-shear point, and their mean
-    scatters half as much over four cycles. Each cycle's own reading stays in
+    Every cycle pre-shears at the same normal stress, so its readings measure the yield locus's
+    single pre-shear point again, and their mean scatters half as much over four cycles. (A
+    polydisperse bed segregates as it is sheared and its readings drift by a few per cent from
+    the first cycle to the last, see docs/virtual-tests.md.) Each cycle's own reading stays in
     ``mu_psh_cycle`` and ``rho_b_cycle``; a cycle without a steady pre-shear plateau (NaN)
     does not count.
     """
