@@ -612,6 +612,150 @@ TEST_CASE("mesh: triangle candidates of 8000 particles in a 256-triangle cylinde
   CHECK(list.due(p, moved_meshes));
 }
 
+namespace {
+
+// Bit for bit equal contact lists (field by field: MeshContact has padding).
+bool same_contacts(const std::vector<MeshContact>& a, const std::vector<MeshContact>& b) {
+  if (a.size() != b.size()) return false;
+  auto same = [](const Vec3& u, const Vec3& v) { return u.x == v.x && u.y == v.y && u.z == v.z; };
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const MeshContact &c = a[k], &d = b[k];
+    if (c.mesh != d.mesh || c.tri != d.tri || !same(c.cp.point, d.cp.point) ||
+        c.cp.wa != d.cp.wa || c.cp.wb != d.cp.wb || c.cp.wc != d.cp.wc ||
+        c.cp.region != d.cp.region || !same(c.normal, d.normal) || c.dist != d.dist)
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("mesh: candidates passed over by the motion bound are out of reach") {
+  // A coarse tube (facets bent by 30 degrees, so edges and corners act) and a plate closing it
+  // at the bottom, both moving; particles near the wall, each step displaced anew from its
+  // position at the build by up to 0.45 skin. Every candidate's contact distance at the step
+  // is at least its bound at the build less both motions, and the contacts found with the
+  // bound are those found without it, bit for bit and in order, also for radii that put a
+  // candidate just within reach.
+  const double rc = 0.01, r = 0.001, skin = 0.0008;
+  TriMesh tube(cylinder_mesh(rc, 0.0, 0.02, 12), "tube");
+  TriMesh floor(square_plate(rc, 0.0), "floor");
+  const std::vector<const TriMesh*> meshes = {&tube, &floor};
+  std::mt19937 rng(4242);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto ball = [&](double radius) {  // uniform in a ball
+    Vec3 v;
+    do v = Vec3{2 * u(rng) - 1, 2 * u(rng) - 1, 2 * u(rng) - 1};
+    while (norm2(v) > 1.0);
+    return radius * v;
+  };
+  dem::Particles p;
+  for (int k = 0; k < 300; ++k) {
+    const double phi = 2 * kPi * u(rng), rho = rc - (r + skin) * 1.2 * u(rng);
+    const double z = k % 3 == 0 ? (r + skin) * 1.2 * u(rng) : 0.02 * u(rng);
+    p.add(p.next_tag(), 1, 1u, Vec3{rho * std::cos(phi), rho * std::sin(phi), z},
+          r * (0.5 + 0.5 * u(rng)), 2500.0);
+  }
+  dem::TriangleNeighborList list;
+  list.build(p, 1u, meshes, skin);
+  std::vector<Vec3> x_build = p.x;
+  const std::vector<double> radius = p.radius;
+  long candidates = 0, passed_over = 0, below_bound = 0, differing = 0, contacts = 0, edges = 0;
+  long rebuilds = 0;
+  std::vector<MeshContact> with, without;
+  for (int step = 0; step < 40; ++step) {
+    for (std::size_t i = 0; i < p.size(); ++i) p.x[i] = x_build[i] + ball(0.45 * skin);
+    // The meshes turn and slide a little further at every step (rebuilt when due).
+    tube.rotate(Vec3{0.0, 0.0, 1.0}, 0.004, Vec3{0.0, 0.0, 0.0});
+    floor.translate(Vec3{0.00001, -0.00002, 0.00001});
+    if (list.due(p, meshes)) {
+      list.build(p, 1u, meshes, skin);
+      x_build = p.x;
+      ++rebuilds;
+      continue;
+    }
+    // The motions the list measured on the way.
+    CHECK_EQ(list.moved2(7), norm2(p.x[7] - x_build[7]));
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const int first = list.first[i], n = list.first[i + 1] - first;
+      const double moved = std::sqrt(list.moved2(i));
+      for (int k = first; k < first + n; ++k) {
+        const dem::TriRef ref = list.refs[k];
+        const TriMesh& mesh = *meshes[ref.mesh];
+        const double now = norm(p.x[i] - mesh.contact_point(ref.tri, p.x[i]).point);
+        const double bound = list.dist[k] - moved - list.mesh_shift()[ref.mesh];
+        ++candidates;
+        if (now < bound - 1e-9 * r) ++below_bound;
+        if (bound > (1.0 + 1e-6) * p.radius[i]) ++passed_over;
+      }
+      // At its own radius, then at radii just above and at the contact distance of each
+      // candidate (the bound must let the one just within reach through).
+      std::vector<double> radii = {p.radius[i]};
+      for (int k = first; k < first + n; ++k) {
+        const TriMesh& mesh = *meshes[list.refs[k].mesh];
+        const double d = norm(p.x[i] - mesh.contact_point(list.refs[k].tri, p.x[i]).point);
+        radii.push_back(d);
+        radii.push_back(std::nextafter(d, 1.0));
+      }
+      const dem::CandidateMotion motion{list.dist.data() + first, moved,
+                                        list.mesh_shift().data()};
+      for (double ri : radii) {
+        dem::find_mesh_contacts(p.x[i], ri, list.refs.data() + first, n, meshes, with, motion);
+        dem::find_mesh_contacts(p.x[i], ri, list.refs.data() + first, n, meshes, without);
+        if (!same_contacts(with, without)) ++differing;
+        contacts += static_cast<long>(without.size());
+        for (const MeshContact& c : without) edges += !c.cp.on_face();
+      }
+    }
+    p.radius = radius;
+  }
+  CHECK_EQ(below_bound, 0L);
+  CHECK_EQ(differing, 0L);
+  CHECK(rebuilds >= 1 && rebuilds < 20);  // the bound served many steps, not only builds
+  CHECK(passed_over > candidates / 10);   // it does pass over candidates
+  CHECK(contacts > 10000);
+  CHECK(edges > 1000);  // edge and corner contacts too, not only faces
+  // A particle that has not moved and a mesh that has not moved since the build: zero motion.
+  list.build(p, 1u, meshes, skin);
+  CHECK(!list.due(p, meshes));
+  CHECK_EQ(list.moved2(3), 0.0);
+  CHECK_EQ(list.mesh_shift()[0], 0.0);
+  const Vec3 shift{0.0001, 0.0, 0.0002};
+  floor.translate(shift);
+  CHECK(!list.due(p, meshes));
+  CHECK_NEAR(list.mesh_shift()[1], norm(shift), 1e-15);
+  CHECK_EQ(list.mesh_shift()[0], 0.0);
+}
+
+TEST_CASE("mesh: the motion bound keeps a centre within the face tolerance beyond an edge") {
+  // The centre lies in the plane, just beyond a boundary edge but within the face tolerance:
+  // LIGGGHTS' contact point is the centre itself (distance 0), while the triangle is a few
+  // nanometres away. A sphere of 1 nm radius touches; the bound must not pass it over.
+  const TriMesh plate(square_plate(1.0, 0.0), "plate");
+  const std::vector<const TriMesh*> meshes = {&plate};
+  // Triangle 0 is (-1,-1,0), (1,-1,0), (1,1,0): its edge y = -1 is a boundary edge, and node
+  // (1,1,0) stands 2 above it, so the centre's weight of that node is -beyond / 2.
+  const double beyond = plate.topology().face_tolerance(0);
+  dem::Particles p;
+  p.add(p.next_tag(), 1, 1u, Vec3{0.5, -1.0 - beyond, 0.0}, 1e-9, 2500.0);
+  dem::TriangleNeighborList list;
+  list.build(p, 1u, meshes, 0.001);
+  CHECK(!list.due(p, meshes));
+  const int n = list.first[1] - list.first[0];
+  CHECK(n >= 1);
+  std::vector<MeshContact> with, without;
+  dem::find_mesh_contacts(p.x[0], p.radius[0], list.refs.data(), n, meshes, without);
+  dem::find_mesh_contacts(p.x[0], p.radius[0], list.refs.data(), n, meshes, with,
+                          {list.dist.data(), std::sqrt(list.moved2(0)), list.mesh_shift().data()});
+  CHECK_EQ(without.size(), std::size_t{1});
+  CHECK(same_contacts(with, without));
+  if (!without.empty()) {
+    CHECK_EQ(without[0].tri, 0u);
+    CHECK(without[0].cp.on_face());
+    CHECK_EQ(without[0].dist, 0.0);
+  }
+}
+
 // --- meshes, motions, primitives, servo ---------------------------------------------------------
 
 TEST_CASE("mesh: rigid motions and frames carried by earlier motions") {

@@ -254,7 +254,10 @@ void FixWallGran::mesh_forces() {
   Particles& P = sim_.atoms;
   const std::size_t n = P.size();
   const std::uint32_t bit = group_bit();
+  // Either way the list now knows how far the particles and meshes moved since its build.
   if (list_.due(P, meshes_)) list_.build(P, bit, meshes_, sim_.neighbor.skin);
+  const double* build_dist = list_.dist.data();
+  const double* mesh_shift = list_.mesh_shift().data();
   const bool same_list = slots_checked_for_build_ == list_.builds();
   slots_checked_for_build_ = list_.builds();
   const std::size_t nm = meshes_.size();
@@ -310,7 +313,8 @@ void FixWallGran::mesh_forces() {
       double* slots = slots_all + i * kMeshSlots * kMeshSlotWidth;
       s.contacts.clear();
       if (P.mask[i] & bit)
-        find_mesh_contacts(P.x[i], P.radius[i], refs + first[i], candidates, meshes_, s.contacts);
+        find_mesh_contacts(P.x[i], P.radius[i], refs + first[i], candidates, meshes_, s.contacts,
+                           {build_dist + first[i], std::sqrt(list_.moved2(i)), mesh_shift});
       if (s.contacts.empty()) {
         // Release the slots of contacts that opened.
         for (int k = 0; k < kMeshSlots; ++k)

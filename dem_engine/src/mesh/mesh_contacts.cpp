@@ -41,34 +41,55 @@ std::vector<int>& scratch_slots() {
   return slots;
 }
 
+// The contact of the sphere (x, r) with candidate `ref` (r2 = r^2), appended to `out` when
+// there is one.
+inline void add_mesh_contact(const Vec3& x, double r, double r2, const TriRef& ref,
+                             const std::vector<const TriMesh*>& meshes,
+                             std::vector<MeshContact>& out) {
+  const TriMesh& mesh = *meshes[ref.mesh];
+  // Every point of the triangle is at least as far as its plane: most candidates end here.
+  const TrianglePlane& plane = mesh.plane(ref.tri);
+  const double s = dot(x - mesh.node(ref.tri, 0), plane.n);
+  if (s * s >= r2 * plane.area2) return;
+  const ClosestPoint cp = mesh.contact_point(ref.tri, x);
+  const Vec3 d = x - cp.point;
+  const double d2 = norm2(d);
+  if (d2 >= r2) return;
+  if (!feature_active(mesh.topology(), ref.tri, cp.region)) return;
+  MeshContact c;
+  c.mesh = ref.mesh;
+  c.tri = ref.tri;
+  c.cp = cp;
+  c.dist = std::sqrt(d2);
+  if (c.dist > 1e-12 * r) {
+    c.normal = (1.0 / c.dist) * d;
+  } else {  // centre on the surface: fall back to the facet normal
+    c.normal = triangle_normal(mesh.node(c.tri, 0), mesh.node(c.tri, 1), mesh.node(c.tri, 2));
+  }
+  out.push_back(c);
+}
+
 }  // namespace
 
 void find_mesh_contacts(const Vec3& x, double r, const TriRef* refs, int n,
                         const std::vector<const TriMesh*>& meshes, std::vector<MeshContact>& out) {
   out.clear();
   const double r2 = r * r;
+  for (int k = 0; k < n; ++k) add_mesh_contact(x, r, r2, refs[k], meshes, out);
+}
+
+void find_mesh_contacts(const Vec3& x, double r, const TriRef* refs, int n,
+                        const std::vector<const TriMesh*>& meshes, std::vector<MeshContact>& out,
+                        const CandidateMotion& motion) {
+  out.clear();
+  const double r2 = r * r;
+  // The bound, the motions and the contact distance round differently, by a few units in the
+  // last place of the coordinates; a margin of 1e-6 r covers that while the coordinates stay
+  // below ~1e8 radii, and costs only the skips of candidates within 1e-6 r of reach.
+  const double reach = (1.0 + 1e-6) * r + motion.moved;
   for (int k = 0; k < n; ++k) {
-    const TriMesh& mesh = *meshes[refs[k].mesh];
-    // Every point of the triangle is at least as far as its plane: most candidates end here.
-    const TrianglePlane& plane = mesh.plane(refs[k].tri);
-    const double s = dot(x - mesh.node(refs[k].tri, 0), plane.n);
-    if (s * s >= r2 * plane.area2) continue;
-    const ClosestPoint cp = mesh.contact_point(refs[k].tri, x);
-    const Vec3 d = x - cp.point;
-    const double d2 = norm2(d);
-    if (d2 >= r2) continue;
-    if (!feature_active(mesh.topology(), refs[k].tri, cp.region)) continue;
-    MeshContact c;
-    c.mesh = refs[k].mesh;
-    c.tri = refs[k].tri;
-    c.cp = cp;
-    c.dist = std::sqrt(d2);
-    if (c.dist > 1e-12 * r) {
-      c.normal = (1.0 / c.dist) * d;
-    } else {  // centre on the surface: fall back to the facet normal
-      c.normal = triangle_normal(mesh.node(c.tri, 0), mesh.node(c.tri, 1), mesh.node(c.tri, 2));
-    }
-    out.push_back(c);
+    if (motion.dist[k] - motion.mesh_shift[refs[k].mesh] > reach) continue;
+    add_mesh_contact(x, r, r2, refs[k], meshes, out);
   }
 }
 

@@ -23,6 +23,25 @@ struct MeshContact {
 void find_mesh_contacts(const Vec3& x, double r, const TriRef* refs, int n,
                         const std::vector<const TriMesh*>& meshes, std::vector<MeshContact>& out);
 
+// What the candidate list (TriangleNeighborList) knows of a particle's candidates: lower bounds
+// of their contact distances at the list's build, and how far the particle and the nodes of
+// each mesh have moved since (m).
+struct CandidateMotion {
+  const double* dist = nullptr;        // per candidate, TriangleNeighborList::dist
+  double moved = 0.0;                  // the particle
+  const double* mesh_shift = nullptr;  // per mesh
+};
+
+// The same contacts in the same order, but candidates that cannot touch are passed over without
+// reading their triangles: no point of a triangle moves farther than its farthest node, so a
+// contact distance falls by at most the particle's and the nodes' motions since the build, and
+// a candidate whose bound, less both, still exceeds r is out of reach. The list holds every
+// triangle within r + skin, so in a dense packing most candidates end here (two in three in a
+// ring shear cell).
+void find_mesh_contacts(const Vec3& x, double r, const TriRef* refs, int n,
+                        const std::vector<const TriMesh*>& meshes, std::vector<MeshContact>& out,
+                        const CandidateMotion& motion);
+
 // Contact history of one particle with the meshes of one wall: kMeshSlots slots of
 // [key, history (kHistorySize)]; key 0 marks a free slot.
 constexpr int kMeshSlots = 8;

@@ -13,6 +13,8 @@ void TriangleNeighborList::build(const Particles& p, std::uint32_t group_bit,
   skin_ = skin;
   checks_ = 0;
   x_at_build_.assign(p.x.begin(), p.x.end());
+  moved2_.assign(n, 0.0);
+  mesh_shift_.assign(meshes.size(), 0.0);
   tag_at_build_.assign(p.tag.begin(), p.tag.end());
   meshes_at_build_ = meshes;
   nodes_at_build_.resize(meshes.size());
@@ -23,8 +25,10 @@ void TriangleNeighborList::build(const Particles& p, std::uint32_t group_bit,
   }
   first.assign(n + 1, 0);
   refs.clear();
+  dist.clear();
   pair_particle_.clear();
   pair_ref_.clear();
+  pair_dist_.clear();
 
   // Bounding box and largest radius of the group.
   Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
@@ -99,6 +103,14 @@ void TriangleNeighborList::build(const Particles& p, std::uint32_t group_bit,
         c_hi[d] = cell_coord(tmax, d);
       }
       if (outside) continue;
+      // The contact point of a projection that counts as in the face (no barycentric weight
+      // below -tolerance) may lie outside the triangle, by at most 4 tolerance max |node - c|
+      // for any point c: its weights differ from those of a point of the triangle by at most
+      // 4 tolerance in sum (twice the negative parts).
+      const Vec3 centroid = (1.0 / 3.0) * (a + b + c);
+      const double spread = std::sqrt(
+          std::max({norm2(a - centroid), norm2(b - centroid), norm2(c - centroid)}));
+      const double face_slack = 4.0 * mesh.topology().face_tolerance(t) * spread;
       const long long span = static_cast<long long>(c_hi[0] - c_lo[0] + 1) *
                              (c_hi[1] - c_lo[1] + 1) * (c_hi[2] - c_lo[2] + 1);
       // Large (e.g. tilted) triangles: skip cells whose centre is too far from the triangle.
@@ -120,9 +132,11 @@ void TriangleNeighborList::build(const Particles& p, std::uint32_t group_bit,
               ++checks_;
               const ClosestPoint cp = closest_point_on_triangle(p.x[i], a, b, c);
               const double reach = p.radius[i] + skin;
-              if (norm2(cp.point - p.x[i]) < reach * reach) {
+              const double d2 = norm2(cp.point - p.x[i]);
+              if (d2 < reach * reach) {
                 pair_particle_.push_back(i);
                 pair_ref_.push_back({static_cast<std::uint32_t>(m), static_cast<std::uint32_t>(t)});
+                pair_dist_.push_back(std::sqrt(d2) - face_slack);
               }
             }
           }
@@ -133,25 +147,32 @@ void TriangleNeighborList::build(const Particles& p, std::uint32_t group_bit,
   for (int i : pair_particle_) ++first[i + 1];
   for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
   refs.resize(pair_ref_.size());
+  dist.resize(pair_ref_.size());
   std::vector<int> fill(first.begin(), first.end() - 1);
-  for (std::size_t k = 0; k < pair_ref_.size(); ++k) refs[fill[pair_particle_[k]]++] = pair_ref_[k];
+  for (std::size_t k = 0; k < pair_ref_.size(); ++k) {
+    const int slot = fill[pair_particle_[k]]++;
+    refs[slot] = pair_ref_[k];
+    dist[slot] = pair_dist_[k];
+  }
 }
 
-bool TriangleNeighborList::due(const Particles& p,
-                               const std::vector<const TriMesh*>& meshes) const {
+bool TriangleNeighborList::due(const Particles& p, const std::vector<const TriMesh*>& meshes) {
   if (forced_ || p.size() != x_at_build_.size() || meshes != meshes_at_build_) return true;
   const double limit2 = 0.25 * skin_ * skin_;
   const std::size_t n = p.size();
   for (std::size_t i = 0; i < n; ++i) {
     if (p.tag[i] != tag_at_build_[i]) return true;
-    if (norm2(p.x[i] - x_at_build_[i]) > limit2) return true;
+    moved2_[i] = norm2(p.x[i] - x_at_build_[i]);
+    if (moved2_[i] > limit2) return true;
   }
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     if (meshes[m]->version() == mesh_version_at_build_[m]) continue;
     const auto& now = meshes[m]->nodes();
     const auto& then = nodes_at_build_[m];
-    for (std::size_t k = 0; k < now.size(); ++k)
-      if (norm2(now[k] - then[k]) > limit2) return true;
+    double most = 0.0;
+    for (std::size_t k = 0; k < now.size(); ++k) most = std::max(most, norm2(now[k] - then[k]));
+    if (most > limit2) return true;
+    mesh_shift_[m] = std::sqrt(most);
   }
   return false;
 }
