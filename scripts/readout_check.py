@@ -27,7 +27,7 @@ if str(ROOT) not in sys.path:
 
 import pandas as pd  # noqa: E402
 
-from demcal.bulk.plane_check import band_check, plane_check  # noqa: E402
+from demcal.bulk.plane_check import plane_check  # noqa: E402
 from demcal.bulk.values import MissingOutputError, read_case_record  # noqa: E402
 
 
@@ -59,15 +59,14 @@ def main(argv: list[str] | None = None) -> int:
         try:
             record = read_case_record(case_dir)
             margin = 2.0 * float(record["particles"]["max_radius"]) * args.margin
-            table = plane_check(case_dir, margin)
-            if args.bands:
-                profile = band_check(case_dir, args.bands)
-                profiles.append(profile.assign(case_dir=str(case_dir)))
+            table, profile = plane_check(case_dir, margin, args.bands)
         except (MissingOutputError, ValueError) as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
         table.insert(0, "case_dir", str(case_dir))
         tables.append(table)
+        if profile is not None:
+            profiles.append(profile.assign(case_dir=str(case_dir)))
     every = pd.concat(tables, ignore_index=True)
     every["ratio"] = every["mu_plane"] / every["mu_wall"]
     with pd.option_context("display.width", 200, "display.max_colwidth", 80):

@@ -39,6 +39,9 @@ def test_an_unrun_deck_names_its_missing_dump(tmp_path: Path) -> None:
     render_case("shear_cell", CASE, cfg, tmp_path)
     with pytest.raises(MissingOutputError, match=r"contacts\.dump: contact dump missing"):
         plane_check(tmp_path)
+    # Bands across the plane are the ring's; the split cell is refused before anything is read.
+    with pytest.raises(MissingOutputError, match="bands need the ring cell"):
+        plane_check(tmp_path, bands=3)
 
 
 def test_the_script_names_the_deck_it_cannot_check(tmp_path: Path) -> None:
