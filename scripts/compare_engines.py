@@ -5,6 +5,8 @@ and seeds, runs every deck on each engine (one thread / one rank), extracts mu_p
 rho_b and aor, and compares the seed means per engine with Welch's t-test, Bonferroni-corrected
 so that the family-wise false-alarm rate is ``--alpha``. Writes ``values.csv`` (every run),
 ``comparison.csv`` and ``comparison.md`` (the table) to ``--out`` and prints the table.
+``--set SECTION.KEY=VALUE`` overrides a configuration key for every deck (validated like the
+file).
 
 Example::
 
@@ -31,20 +33,18 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from demcal.bulk.convergence import add_parameter_sets  # noqa: E402
 from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     collect_values,
     load_status,
     plan_runs,
     run_jobs,
-    select_parameter_sets,
 )
 from demcal.bulk.engine_statistics import (  # noqa: E402
     compare_engines,
     markdown_table,
 )
-from demcal.core.config import load_config  # noqa: E402
+from demcal.bulk.study_options import add_study_options, study_sets, study_settings  # noqa: E402
 
 
 def freeze_engine(out: Path) -> tuple[str, str]:
@@ -74,26 +74,10 @@ def freeze_engine(out: Path) -> tuple[str, str]:
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--config", default="config/tiny.yaml", help="configuration YAML")
+    add_study_options(parser, config="config/tiny.yaml", sets=["low", "middle", "cohesion"])
     parser.add_argument("--seeds", type=int, default=4, help="seeds per engine, set and test")
     parser.add_argument(
         "--first-seed", type=int, default=1, help="seeds are first-seed, first-seed + 1, ..."
-    )
-    parser.add_argument(
-        "--sets",
-        nargs="*",
-        default=["low", "middle", "cohesion"],
-        help="named parameter sets (low, middle, high, interlocking, cohesion; none with --sets "
-        "alone: only the --extra-set ones)",
-    )
-    parser.add_argument(
-        "--extra-set",
-        action="append",
-        default=[],
-        metavar="NAME=key:value,...",
-        help="a further parameter set, run after --sets (every contact parameter: "
-        "coefficientFriction, coefficientRollingFriction, coefficientRestitution, density; "
-        "optionally cohesionEnergyDensity, wallFriction); repeatable",
     )
     parser.add_argument(
         "--engines",
@@ -125,14 +109,8 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
-    settings = load_config(Path(args.config))
-    try:
-        sets = select_parameter_sets(args.sets, str(settings.get("profile", "tiny")))
-        sets = add_parameter_sets(sets, args.extra_set)
-    except ValueError as exc:
-        raise SystemExit(f"--sets / --extra-set: {exc}") from None
-    if not sets:
-        raise SystemExit("no parameter sets: name some with --sets or add one with --extra-set")
+    settings = study_settings(args)
+    sets = study_sets(args, settings, "tiny")
     names = set(args.engines) | set(args.compare)
     if any(e not in ENGINE_COMMANDS for e in names):
         raise SystemExit(f"engines must be among {sorted(ENGINE_COMMANDS)}")
@@ -170,7 +148,8 @@ def main(argv: list[str] | None = None) -> int:
     bad = values[values["status"] != "ok"].drop_duplicates(["set", "engine", "seed", "test"])
     stress = args.normal_stress or settings["shear_cell"]["normal_stresses"][0]
     text = (
-        f"Config {args.config}, sets {', '.join(sets)}, seeds {seeds}, shear cell at "
+        f"Config {' '.join([args.config, *args.overrides])}, sets {', '.join(sets)}, "
+        f"seeds {seeds}, shear cell at "
         f"{stress:g} Pa and P = {args.P:g}; started {started:%Y-%m-%d %H:%M} UTC, "
         f"wall time of this call {wall / 60:.1f} min ({len(jobs)} runs compared).\n"
     )

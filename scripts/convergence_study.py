@@ -42,7 +42,6 @@ import pandas as pd  # noqa: E402
 from demcal.bulk.convergence import (  # noqa: E402
     FACTORS,
     Factor,
-    add_parameter_sets,
     plan_study,
     quantities_of,
     restrict_levels,
@@ -53,39 +52,20 @@ from demcal.bulk.engine_comparison import (  # noqa: E402
     collect_values,
     load_status,
     run_jobs,
-    select_parameter_sets,
 )
-from demcal.core.config import ConfigError, load_config, with_overrides  # noqa: E402
+from demcal.bulk.study_options import add_study_options, study_sets, study_settings  # noqa: E402
 from demcal.core.parameters import PARAMETERS  # noqa: E402
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--config", default="config/config.yaml", help="configuration YAML")
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="SECTION.KEY=VALUE",
-        help="override a configuration key for every deck (VALUE read as YAML); repeatable",
+    add_study_options(
+        parser,
+        config="config/config.yaml",
+        sets=["low", "middle", "high"],
+        extra_set_help="a further parameter set, e.g. where a calibration landed",
     )
     parser.add_argument("--factors", nargs="+", default=list(FACTORS), help="factors to vary")
-    parser.add_argument(
-        "--sets",
-        nargs="*",
-        default=["low", "middle", "high"],
-        help="reference parameter sets (none with --sets alone: only the --extra-set ones)",
-    )
-    parser.add_argument(
-        "--extra-set",
-        action="append",
-        default=[],
-        metavar="NAME=key:value,...",
-        help="a further parameter set, e.g. where a calibration landed (every contact "
-        "parameter: coefficientFriction, coefficientRollingFriction, coefficientRestitution, "
-        "density); repeatable",
-    )
     parser.add_argument(
         "--levels",
         type=float,
@@ -185,20 +165,8 @@ def main(argv: list[str] | None = None) -> int:
     unknown = [f for f in args.factors if f not in FACTORS]
     if unknown:
         raise SystemExit(f"unknown factors {unknown}; choose from {sorted(FACTORS)}")
-    try:
-        settings = with_overrides(load_config(Path(args.config)), args.overrides, args.config)
-    except ConfigError as exc:
-        raise SystemExit(str(exc)) from None
-    try:
-        sets = select_parameter_sets(args.sets, str(settings.get("profile", "quick")))
-    except ValueError as exc:
-        raise SystemExit(str(exc)) from None
-    try:
-        sets = add_parameter_sets(sets, args.extra_set)
-    except ValueError as exc:
-        raise SystemExit(f"--extra-set: {exc}") from None
-    if not sets:
-        raise SystemExit("no parameter sets: name some with --sets or add one with --extra-set")
+    settings = study_settings(args)
+    sets = study_sets(args, settings, "quick")
     chosen = {name: FACTORS[name] for name in args.factors}
     if args.levels:
         try:

@@ -31,37 +31,19 @@ if str(ROOT) not in sys.path:
 
 import pandas as pd  # noqa: E402
 
-from demcal.bulk.convergence import add_parameter_sets  # noqa: E402
 from demcal.bulk.cycle_drift import collect_cycle_values, cycle_table  # noqa: E402
 from demcal.bulk.engine_comparison import (  # noqa: E402
     ENGINE_COMMANDS,
     load_status,
     plan_runs,
     run_jobs,
-    select_parameter_sets,
 )
-from demcal.core.config import ConfigError, load_config, with_overrides  # noqa: E402
+from demcal.bulk.study_options import add_study_options, study_sets, study_settings  # noqa: E402
 
 
 def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--config", default="config/config.yaml", help="configuration YAML")
-    parser.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="SECTION.KEY=VALUE",
-        help="override a configuration key (VALUE read as YAML); repeatable",
-    )
-    parser.add_argument("--sets", nargs="*", default=["low", "middle", "high"])
-    parser.add_argument(
-        "--extra-set",
-        action="append",
-        default=[],
-        metavar="NAME=key:value,...",
-        help="a further parameter set (every contact parameter); repeatable",
-    )
+    add_study_options(parser, config="config/config.yaml", sets=["low", "middle", "high"])
     parser.add_argument("--seeds", type=int, default=3, help="decks per set")
     parser.add_argument("--normal-stress", type=float, default=1068.0, help="pre-shear, Pa")
     parser.add_argument(
@@ -111,15 +93,11 @@ def main(argv: list[str] | None = None) -> int:
             raise SystemExit(f"{args.dataset}: {exc}") from None
         print(markdown(table, None, f"Shear-cell decks of {args.dataset}"))
         return 0
-    try:
-        settings = with_overrides(load_config(Path(args.config)), args.overrides, args.config)
-    except ConfigError as exc:
-        raise SystemExit(str(exc)) from None
+    settings = study_settings(args)
     if len(settings["shear_cell"]["P"]) < 2:
         raise SystemExit("shear_cell.P: a deck with cycles needs at least two values of P")
+    sets = study_sets(args, settings, "quick")
     try:
-        sets = select_parameter_sets(args.sets, str(settings.get("profile", "quick")))
-        sets = add_parameter_sets(sets, args.extra_set)
         out = Path(args.out)
         # P=None: every value of shear_cell.P runs as a cycle of one deck.
         jobs = plan_runs(

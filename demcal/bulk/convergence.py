@@ -27,21 +27,13 @@ import numpy as np
 import pandas as pd
 
 from demcal.bulk.engine_comparison import BULK_VALUES, RunJob
-from demcal.core.parameters import (
-    CONTACT_PARAMETERS,
-    OPTIONAL_CONTACT_PARAMETERS,
-    TESTS,
-    out_of_bounds,
-    unknown_parameter,
-)
+from demcal.core.parameters import TESTS
 from demcal.virtual_tests.deck import render_case
 
 __all__ = [
     "FACTORS",
     "TOLERANCES",
     "Factor",
-    "add_parameter_sets",
-    "parse_parameter_set",
     "plan_study",
     "quantities_of",
     "summarise",
@@ -251,76 +243,6 @@ def restrict_levels(factor: Factor, values: Sequence[float]) -> Factor:
         if any(math.isclose(v, k, rel_tol=1e-9) for v in values)
     )
     return replace(factor, levels=kept)
-
-
-def parse_parameter_set(text: str) -> tuple[str, dict[str, float]]:
-    """A named parameter set from the command line, e.g. one where a calibration landed.
-
-    Parameters
-    ----------
-    text : str
-        ``NAME=key:value,key:value,...`` with every contact parameter (``coefficientFriction``,
-        ``coefficientRollingFriction``, ``coefficientRestitution``, ``density`` in kg/m^3) and
-        optionally ``cohesionEnergyDensity`` (J/m^3) or ``wallFriction``.
-
-    Returns
-    -------
-    tuple of (str, dict)
-        The set's name and its parameters.
-
-    Raises
-    ------
-    ValueError
-        Malformed text, an unknown or repeated parameter, a value that is not a number or
-        outside its bounds, or a contact parameter missing; the message names the culprit.
-    """
-    name, sep, body = text.partition("=")
-    name = name.strip()
-    if not sep or not name or "/" in name:
-        raise ValueError(f"parameter set {text!r}: expected NAME=key:value,... (NAME without '/')")
-    params: dict[str, float] = {}
-    for item in body.split(","):
-        key, colon, raw = (part.strip() for part in item.partition(":"))
-        if not colon:
-            raise ValueError(f"parameter set {name}: {item.strip()!r} is not key:value")
-        why = unknown_parameter(key)
-        if why is None and key not in CONTACT_PARAMETERS + OPTIONAL_CONTACT_PARAMETERS:
-            why = "not a contact parameter"
-        if why is not None:
-            raise ValueError(f"parameter set {name}: {key}: {why}")
-        if key in params:
-            raise ValueError(f"parameter set {name}: {key} given twice")
-        try:
-            value = float(raw)
-        except ValueError:
-            raise ValueError(f"parameter set {name}: {key} = {raw!r} is not a number") from None
-        problem = out_of_bounds(key, value)
-        if problem is not None:
-            raise ValueError(f"parameter set {name}: {problem}")
-        params[key] = value
-    missing = [key for key in CONTACT_PARAMETERS if key not in params]
-    if missing:
-        raise ValueError(f"parameter set {name}: missing {', '.join(missing)}")
-    return name, params
-
-
-def add_parameter_sets(
-    sets: Mapping[str, Mapping[str, float]], texts: Sequence[str]
-) -> dict[str, dict[str, float]]:
-    """``sets`` with the sets of :func:`parse_parameter_set` from ``texts`` added after them.
-
-    Raises
-    ------
-    ValueError
-        A text that does not parse (the message names the culprit), or a name already taken.
-    """
-    merged = {name: dict(params) for name, params in sets.items()}
-    for text in texts:
-        name, params = parse_parameter_set(text)
-        if name in merged:
-            raise ValueError(f"a set named {name} is already in the study")
-        merged[name] = params
-    return merged
 
 
 def _apply(settings: Mapping[str, Any], overrides: Mapping[str, Any]) -> dict[str, Any]:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -15,8 +14,6 @@ import pytest
 from demcal.bulk.convergence import (
     FACTORS,
     Factor,
-    add_parameter_sets,
-    parse_parameter_set,
     plan_study,
     restrict_levels,
     summarise,
@@ -171,40 +168,6 @@ def test_every_factor_level_renders_on_the_quick_profile(tmp_path: Path) -> None
             assert record["setup"]["cycle_mode"] == ("continue" if geometry == "ring" else "return")
 
 
-def test_parse_parameter_set_reads_every_contact_parameter() -> None:
-    name, params = parse_parameter_set(
-        "sinter=coefficientFriction:0.557, coefficientRollingFriction:0.919,"
-        "coefficientRestitution:0.703,density:3116,cohesionEnergyDensity:2e4"
-    )
-    assert name == "sinter"
-    assert params == {
-        "coefficientFriction": 0.557,
-        "coefficientRollingFriction": 0.919,
-        "coefficientRestitution": 0.703,
-        "density": 3116.0,
-        "cohesionEnergyDensity": 20000.0,
-    }
-
-
-@pytest.mark.parametrize(
-    ("text", "message"),
-    [
-        ("coefficientFriction:0.5", "expected NAME=key:value"),
-        ("a/b=coefficientFriction:0.5", "NAME without '/'"),
-        ("s=coefficientFriction 0.5", "is not key:value"),
-        ("s=coefficientFricton:0.5", "did you mean coefficientFriction"),
-        ("s=youngsModulus:1e7", "not a contact parameter"),
-        ("s=coefficientFriction:0.5,coefficientFriction:0.6", "given twice"),
-        ("s=coefficientFriction:high", "'high' is not a number"),
-        ("s=coefficientRestitution:1.5", "coefficientRestitution = 1.5 is outside"),
-        ("s=coefficientFriction:0.5,density:3000", "missing coefficientRollingFriction"),
-    ],
-)
-def test_parse_parameter_set_names_what_is_wrong(text: str, message: str) -> None:
-    with pytest.raises(ValueError, match=re.escape(message)):
-        parse_parameter_set(text)
-
-
 @pytest.mark.parametrize(
     ("args", "message"),
     [
@@ -255,14 +218,3 @@ def test_restricted_levels_keep_their_order_and_the_most_refined_is_the_referenc
     assert summary.loc[14.0, "reference"] == 35.0 and summary.loc[9.0, "deviation"] == 0.0
     with pytest.raises(ValueError, match="not among its levels"):
         restrict_levels(FACTORS["aor_lift_time"], [3.0])
-
-
-def test_added_sets_come_after_the_named_ones_and_leave_them_alone() -> None:
-    named = {"low": {**MIDDLE, "coefficientFriction": 0.3}}
-    text = "wet=" + ",".join(f"{k}:{v}" for k, v in MIDDLE.items()) + ",cohesionEnergyDensity:5e4"
-    sets = add_parameter_sets(named, [text])
-    assert list(sets) == ["low", "wet"]
-    assert sets["wet"] == {**MIDDLE, "cohesionEnergyDensity": 50000.0}
-    assert list(named) == ["low"]
-    with pytest.raises(ValueError, match="a set named low is already in the study"):
-        add_parameter_sets(named, ["low=" + text.partition("=")[2]])
