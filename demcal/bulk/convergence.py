@@ -189,6 +189,15 @@ FACTORS: dict[str, Factor] = {
             "shear_cell.dCylDp",
         ),
         Factor(
+            "ring_height",
+            "shear_cell",
+            "ring cell: bed height (outer radii R; at dCylDp 24, 0.5 R = 6 particle diameters)",
+            # The quick ring's shear zone spans the 4 diameters between the floor's and the
+            # lid's bars; a taller bed gives it room (the plane stays at half the height).
+            _levels("shear_cell.fill_height", (0.5, 0.75, 1.0), shear_cell__geometry="ring"),
+            "shear_cell.fill_height",
+        ),
+        Factor(
             "aor_dCylDp",
             "angle_of_repose",
             "cylinder diameter / largest particle diameter dCylDp",

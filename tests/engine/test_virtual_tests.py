@@ -24,6 +24,7 @@ import pandas as pd
 import pytest
 
 from demcal.bulk.plane_check import plane_check
+from demcal.bulk.shear_zone_check import shear_zone_check
 from demcal.bulk.values import extract
 from demcal.core.config import load_config
 from demcal.engine_io.fix_output import read_print_file
@@ -230,6 +231,23 @@ def test_ring_contacts_across_the_shear_plane_carry_the_torque_readout(
         compared = plane_check(runs[f"ring_{name}_seed{SEEDS[0]}"]).windows
         assert len(compared) == 2 and (compared["snapshots"] >= 3).all(), (name, compared)
         assert np.allclose(compared["mu_plane"], compared["mu_wall"], rtol=0.05), (name, compared)
+
+
+def test_ring_shears_across_the_gap_between_its_bars(runs: dict[str, Path]) -> None:
+    # The floor's bars carry the bottom layers with it and the lid's hold the top ones: the
+    # speed falls from the floor's to the lid's across the bed, and the zone where it falls
+    # from 0.9 to 0.1 of the floor's lies between the bar tips (1 and 5 of the 6 diameters;
+    # quick ring, 10 070 Pa: 1.9-4.8, 2.6-3.0 diameters wide). Its inertial number in the
+    # interior region is above that of the bed sheared evenly, which is above that of a band
+    # ten diameters wide.
+    for name in RING_SETS:
+        check = shear_zone_check(runs[f"ring_{name}_seed{SEEDS[0]}"])
+        top = check.profile[check.profile["n"] >= 10]
+        assert top["u"].iloc[0] > 0.9 and abs(top["u"].iloc[-1]) < 0.1, (name, check.profile)
+        s = check.summary
+        assert 0.8 < s["zone_lo_d"] < s["zone_hi_d"] < s["bed_d"] - 0.8, (name, s)
+        assert 1.0 < s["width_d"] < 4.5, (name, s)
+        assert s["I_interior"] > s["I_bed"] > s["I_nominal"], (name, s)
 
 
 def test_bulk_density_scales_with_particle_density(runs: dict[str, Path]) -> None:

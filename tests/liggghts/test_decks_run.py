@@ -29,6 +29,7 @@ from demcal.application.chute_cooler.analysis import analyse_run, index_summary,
 from demcal.application.chute_cooler.deck import DECK_NAME as CHUTE_DECK
 from demcal.application.chute_cooler.deck import render_chute_cooler
 from demcal.bulk.plane_check import plane_check
+from demcal.bulk.shear_zone_check import shear_zone_check
 from demcal.bulk.values import extract
 from demcal.core.config import load_config
 from demcal.engine_io.fix_output import read_print_file
@@ -199,6 +200,12 @@ def test_ring_shear_cell_deck_runs_on_two_mpi_ranks(tmp_path: Path) -> None:
     counted = DENSITY * 4.0 / 3.0 * math.pi * float(np.sum(vtk.arrays["radius"][inside] ** 3))
     assert near["interior_mass"] == pytest.approx(counted, rel=0.03), (inside.sum(), near)
     assert (values["rho_b"] > values["rho_b_cell"]).all(), values
+    # The turning floor's bars carry the bed's bottom, the lid's hold its top: the zone where
+    # the speed falls from 0.9 to 0.1 of the floor's lies between the bar tips (engine, one
+    # rank: 1.7-2.3 to 4.6-5.1 of 6 diameters).
+    zone = shear_zone_check(tmp_path).summary
+    assert 0.8 < zone["zone_lo_d"] < zone["zone_hi_d"] < zone["bed_d"] - 0.8, zone
+    assert 1.0 < zone["width_d"] < 4.5 and zone["I_interior"] > zone["I_bed"], zone
 
 
 def test_angle_of_repose_deck_runs(tmp_path: Path) -> None:

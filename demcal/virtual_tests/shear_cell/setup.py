@@ -187,8 +187,10 @@ class ShearCellSetup(RunSetup):
     preshear_time, shear_time, unload_time : float
         Durations, s.
     inertial_number_min_stress : float
-        Inertial number of the shear band (10 particle diameters wide) at the smallest shear
-        normal stress, -.
+        Nominal inertial number of a shear band 10 particle diameters wide at the smallest
+        shear normal stress, -. The quick ring shears across the 4 diameters between its bars,
+        at about three times this in its interior (measured from a run's velocity profile by
+        :mod:`demcal.bulk.shear_zone_check`).
     contact_dump_every : int
         Steps between contact snapshots (``shear_cell.contact_snapshots`` per pre-shear), 0 for
         none.
