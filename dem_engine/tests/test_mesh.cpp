@@ -556,6 +556,98 @@ TEST_CASE("mesh: history does not move between faces bent more than the curvatur
   }
 }
 
+TEST_CASE("mesh: the live-slot record follows the keys through overflow and release") {
+  // A sphere on the axis of a 12-sided tube slightly narrower than it touches 12 faces (two
+  // coplanar triangles each): more contacts than slots.
+  const TriMesh tube(cylinder_mesh(0.0099, -0.02, 0.02, 12), "tube");
+  const std::vector<const TriMesh*> meshes = {&tube};
+  std::vector<dem::TriRef> refs;
+  for (std::uint32_t t = 0; t < tube.size(); ++t) refs.push_back({0, t});
+  std::vector<double> slots(dem::kMeshSlots * dem::kMeshSlotWidth, 0.0);
+  std::vector<double*> hist;
+  std::vector<double> overflow(64 * dem::kHistorySize);
+  std::uint32_t live = 0;
+  std::vector<MeshContact> c;
+  const Vec3 path[] = {{0, 0, 0}, {0, 0, 0.001}, {0.0001, 0, 0}, {0.003, 0.002, 0},
+                       {0.009, 0, 0}, {0, 0, 0}, {0, 0.0096, 0}, {0, 0, 0.0005}};
+  int overflowed = 0;
+  for (const Vec3& x : path) {
+    find_mesh_contacts(x, 0.01, refs.data(), static_cast<int>(refs.size()), meshes, c);
+    overflowed += dem::assign_history_slots(slots.data(), live, c, meshes, hist, overflow.data());
+    CHECK_EQ(live, dem::live_slots(slots.data()));
+    for (double* h : hist) h[0] += 1.0;  // the contacts' springs
+  }
+  CHECK(overflowed > 0);
+  // Released slots are all zeros, and the record is empty.
+  dem::release_slots(slots.data(), live);
+  CHECK_EQ(live, 0u);
+  CHECK(std::all_of(slots.begin(), slots.end(), [](double v) { return v == 0.0; }));
+}
+
+TEST_CASE("mesh: wall/gran keeps its live-slot record through opening contacts and resorting") {
+  TempDir dir;
+  const std::string stl = dir.file("plate.stl");
+  dem::write_stl_ascii(stl, square_plate(0.01, 0.0));
+  auto sim = make_simulation();
+  // No integration: the particles stay put while the plate sinks by 1e-6 m a step (a contact
+  // opens when the plate has sunk by its overlap; the triangle list is rebuilt every 10 steps).
+  for (const std::string& line : std::vector<std::string>{
+           "neighbor 0.00002 bin", "timestep 1e-5",
+           "fix plate all mesh/surface file " + stl + " type 1",
+           "fix w all wall/gran model hertz tangential history mesh n_meshes 1 meshes plate",
+           "fix sink all move/mesh mesh plate linear 0 0 -0.1",
+           "create_atoms 1 single 0 0 0.0004 units box",             // overlap 1e-4
+           "create_atoms 1 single 0.003 0 0.00049 units box",        // overlap 1e-5
+           "create_atoms 1 single -0.003 0.003 0.00051 units box",   // within the skin, apart
+           "create_atoms 1 single 0.005 -0.005 0.00042 units box",   // overlap 8e-5
+           "create_atoms 1 single -0.006 -0.004 0.0004 units box",   // overlap 1e-4
+           "set group all diameter 0.001 density 2500"})
+    deck(*sim, line);
+  dem::Particles& p = sim->atoms;
+  // The handles of the fix's extras (registering a name again returns its handle).
+  const std::size_t slots_h = p.register_extra("wall/gran:w:mesh", 0);
+  const std::size_t live_h = p.register_extra("wall/gran:w:mesh_live", 0);
+  auto live_of = [&](std::int64_t tag) {
+    const long i = p.index_of(tag);
+    CHECK(i >= 0);
+    return i >= 0 ? p.extra(live_h)[static_cast<std::size_t>(i)] : -1.0;
+  };
+  auto check_records = [&] {
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double* slots = p.extra(slots_h).data() + i * dem::kMeshSlots * dem::kMeshSlotWidth;
+      CHECK_EQ(p.extra(live_h)[i], static_cast<double>(dem::live_slots(slots)));
+      if (p.extra(live_h)[i] == 0.0)
+        CHECK(std::all_of(slots, slots + dem::kMeshSlots * dem::kMeshSlotWidth,
+                          [](double v) { return v == 0.0; }));
+    }
+  };
+  deck(*sim, "run 2");
+  check_records();
+  CHECK(live_of(1) != 0.0 && live_of(2) != 0.0 && live_of(4) != 0.0);
+  CHECK_EQ(live_of(3), 0.0);
+  deck(*sim, "run 20");  // particle 2's contact has opened; the list was rebuilt twice
+  check_records();
+  CHECK_EQ(live_of(2), 0.0);
+  CHECK(live_of(1) != 0.0 && live_of(4) != 0.0);
+  // Deleted and reordered particles take their records along.
+  deck(*sim, "region gone block 0.004 0.006 -0.006 -0.004 -0.001 0.001 units box");
+  deck(*sim, "delete_atoms region gone compress no");
+  CHECK_EQ(p.index_of(4), -1L);
+  std::vector<std::size_t> reversed(p.size());
+  for (std::size_t k = 0; k < reversed.size(); ++k) reversed[k] = reversed.size() - 1 - k;
+  p.permute(reversed);
+  check_records();
+  CHECK(live_of(1) != 0.0 && live_of(5) != 0.0);
+  deck(*sim, "create_atoms 1 single 0.0 0.005 0.00043 units box");  // a newcomer touching
+  deck(*sim, "set atom 6 diameter 0.001 density 2500");
+  deck(*sim, "run 3");
+  check_records();
+  CHECK(live_of(6) != 0.0 && live_of(1) != 0.0);
+  deck(*sim, "run 200");  // every contact has opened
+  check_records();
+  for (std::size_t i = 0; i < p.size(); ++i) CHECK_EQ(p.extra(live_h)[i], 0.0);
+}
+
 // --- candidate search --------------------------------------------------------------------------
 
 TEST_CASE("mesh: triangle candidates of 8000 particles in a 256-triangle cylinder") {

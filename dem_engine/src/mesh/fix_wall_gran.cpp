@@ -97,6 +97,7 @@ FixWallGran::FixWallGran(Simulation& sim, const Command& command) : Fix(sim, com
     }
     history_ =
         sim.atoms.register_extra("wall/gran:" + id() + ":mesh", kMeshSlots * kMeshSlotWidth);
+    live_ = sim.atoms.register_extra("wall/gran:" + id() + ":mesh_live", 1);
   } else {
     throw EngineError("expected 'primitive' or 'mesh', got '" + a[p] + "'");
   }
@@ -268,6 +269,7 @@ void FixWallGran::mesh_forces() {
     ref[m] = mesh_fixes_[m]->reference_point();
   }
   double* slots_all = P.extra(history_).data();
+  double* live_all = P.extra(live_).data();
   const int* first = list_.first.data();
   const TriRef* refs = list_.refs.data();
   double worst = 0.0;
@@ -315,16 +317,19 @@ void FixWallGran::mesh_forces() {
       if (P.mask[i] & bit)
         find_mesh_contacts(P.x[i], P.radius[i], refs + first[i], candidates, meshes_, s.contacts,
                            {build_dist + first[i], std::sqrt(list_.moved2(i)), mesh_shift});
+      // Most particles near a mesh touch none of it and hold no slot: their slots stay unread.
+      std::uint32_t live = static_cast<std::uint32_t>(live_all[i]);
       if (s.contacts.empty()) {
-        // Release the slots of contacts that opened.
-        for (int k = 0; k < kMeshSlots; ++k)
-          if (slots[k * kMeshSlotWidth] != 0.0)
-            std::fill(slots + k * kMeshSlotWidth, slots + (k + 1) * kMeshSlotWidth, 0.0);
+        if (live != 0) {  // contacts that opened
+          release_slots(slots, live);
+          live_all[i] = 0.0;
+        }
         continue;
       }
       if (s.contacts.size() > kMaxContacts) s.contacts.resize(kMaxContacts);
       const int unkept =
-          assign_history_slots(slots, s.contacts, meshes_, s.history, s.overflow.data());
+          assign_history_slots(slots, live, s.contacts, meshes_, s.history, s.overflow.data());
+      live_all[i] = static_cast<double>(live);
       overflow += unkept;
       if (count + s.contacts.size() > kWallChunk) flush();
       for (std::size_t k = 0; k < s.contacts.size(); ++k) {

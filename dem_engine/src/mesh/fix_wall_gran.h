@@ -19,9 +19,10 @@ namespace dem {
 // Particles of the group interact with the wall from the side their centre is on; forces and
 // torques are added in post_force. One contact history per particle and contact (primitive:
 // one; mesh: up to kMeshSlots, see assign_history_slots) lives in per-particle storage and is
-// cleared when the contact opens. Primitive-wall candidates are the particles near the wall at
-// the last neighbour build; mesh candidates come from a TriangleNeighborList rebuilt
-// when particles or meshes moved more than skin/2.
+// cleared when the contact opens; with meshes a per-particle record of the slots in use lets
+// the particles that hold none skip their slots. Primitive-wall candidates are the particles
+// near the wall at the last neighbour build; mesh candidates come from a TriangleNeighborList
+// rebuilt when particles or meshes moved more than skin/2.
 class FixWallGran : public Fix {
  public:
   FixWallGran(Simulation& sim, const Command& command);
@@ -63,6 +64,10 @@ class FixWallGran : public Fix {
   std::vector<std::uint32_t> stress_bits_;  // per mesh: group bit if it tracks stress, else 0
   std::vector<Vec3> reference_;             // per mesh: torque reference point
   std::size_t history_ = 0;                 // Particles extra handle
+  // Particles extra handle: per particle, a bit per history slot holding a contact (mesh mode;
+  // live_slots of its slots, kept by assign_history_slots and release_slots). An extra, so that
+  // it moves with the slots when particles are added, removed or reordered.
+  std::size_t live_ = 0;
   bool overflow_warned_ = false;
 
   struct Scratch {

@@ -93,12 +93,33 @@ void find_mesh_contacts(const Vec3& x, double r, const TriRef* refs, int n,
   }
 }
 
+std::uint32_t live_slots(const double* slots) {
+  std::uint32_t live = 0;
+  for (int s = 0; s < kMeshSlots; ++s)
+    if (slots[s * kMeshSlotWidth] != 0.0) live |= 1u << s;
+  return live;
+}
+
+void release_slots(double* slots, std::uint32_t& live) {
+  for (int s = 0; s < kMeshSlots; ++s)
+    if (live & (1u << s)) std::fill_n(slots + s * kMeshSlotWidth, kMeshSlotWidth, 0.0);
+  live = 0;
+}
+
 int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
                          const std::vector<const TriMesh*>& meshes, std::vector<double*>& history,
                          double* overflow) {
-  // The keys as the previous step left them (step 1 writes no slot).
+  std::uint32_t live = live_slots(slots);
+  return assign_history_slots(slots, live, contacts, meshes, history, overflow);
+}
+
+int assign_history_slots(double* slots, std::uint32_t& live, std::vector<MeshContact>& contacts,
+                         const std::vector<const TriMesh*>& meshes, std::vector<double*>& history,
+                         double* overflow) {
+  auto is_live = [&](int s) { return (live & (1u << s)) != 0; };
+  // The keys as the previous step left them (step 1 writes no slot); free slots are not read.
   double keys[kMeshSlots];
-  for (int s = 0; s < kMeshSlots; ++s) keys[s] = slots[s * kMeshSlotWidth];
+  for (int s = 0; s < kMeshSlots; ++s) keys[s] = is_live(s) ? slots[s * kMeshSlotWidth] : 0.0;
   auto previous_slot = [&](double key) {
     for (int s = 0; s < kMeshSlots; ++s)
       if (keys[s] == key) return s;
@@ -130,11 +151,12 @@ int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
   //    coplanar neighbour triangle if there is one.
   auto slot = [&](int s) { return slots + s * kMeshSlotWidth; };
   int overflowed = 0;
-  // The slots as the previous step left them, kept only when a new contact may copy from one
-  // (the slot it copies from can be given to another new contact below).
+  // The live slots as the previous step left them, kept only when a new contact may copy from
+  // one (the slot it copies from can be given to another new contact below).
   double before[kMeshSlots * kMeshSlotWidth];
   if (std::any_of(kept_slot.begin(), kept_slot.end(), [](int s) { return s < 0; }))
-    std::copy(slots, slots + kMeshSlots * kMeshSlotWidth, before);
+    for (int s = 0; s < kMeshSlots; ++s)
+      if (is_live(s)) std::copy_n(slot(s), kMeshSlotWidth, before + s * kMeshSlotWidth);
   for (std::size_t c = 0; c < acting; ++c) {
     if (kept_slot[c] >= 0) {
       history[c] = slot(kept_slot[c]) + 1;
@@ -149,9 +171,10 @@ int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
       if (tri != mc.tri && meshes[mc.mesh]->topology().coplanar_neighbours(tri, mc.tri))
         source = before + s * kMeshSlotWidth + 1;
     }
+    // A slot not used at this step holds what the previous step left.
     int best = -1;
     for (int s = 0; s < kMeshSlots && best < 0; ++s)
-      if (!used[s] && slot(s)[0] == 0.0) best = s;
+      if (!used[s] && !is_live(s)) best = s;
     for (int s = 0; s < kMeshSlots && best < 0; ++s)
       if (!used[s]) best = s;
     double* h = nullptr;
@@ -168,8 +191,12 @@ int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
     history[c] = h;
   }
   // 3. Release the slots of contacts that opened (a free slot, key 0, is all zeros already).
-  for (int s = 0; s < kMeshSlots; ++s)
-    if (!used[s] && slot(s)[0] != 0.0) std::fill(slot(s), slot(s) + kMeshSlotWidth, 0.0);
+  std::uint32_t now = 0;
+  for (int s = 0; s < kMeshSlots; ++s) {
+    if (used[s]) now |= 1u << s;
+    else if (is_live(s)) std::fill(slot(s), slot(s) + kMeshSlotWidth, 0.0);
+  }
+  live = now;
   return overflowed;
 }
 

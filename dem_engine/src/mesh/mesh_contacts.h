@@ -46,6 +46,7 @@ void find_mesh_contacts(const Vec3& x, double r, const TriRef* refs, int n,
 // [key, history (kHistorySize)]; key 0 marks a free slot.
 constexpr int kMeshSlots = 8;
 constexpr int kMeshSlotWidth = 1 + kHistorySize;
+static_assert(kMeshSlots <= 32, "a bit per slot in a 32-bit word");
 
 // Decides which contacts of one particle act and assigns them a history (kHistorySize
 // doubles), with LIGGGHTS' rules, taking `contacts` in order:
@@ -57,8 +58,18 @@ constexpr int kMeshSlotWidth = 1 + kHistorySize;
 //   contact moved across a flat or gently bent edge), else with a zero history.
 // Slots of contacts that opened are cleared. Contacts beyond kMeshSlots get a zero history in
 // `overflow` (kHistorySize doubles each) that is not kept; returns the number of such contacts.
+// `live` has bit s set exactly when slot s has a non-zero key, before and after: only those
+// slots are read, so a particle with one or two contacts touches one or two of its slots.
+int assign_history_slots(double* slots, std::uint32_t& live, std::vector<MeshContact>& contacts,
+                         const std::vector<const TriMesh*>& meshes, std::vector<double*>& history,
+                         double* overflow);
+// The same, with the live slots read from the keys.
 int assign_history_slots(double* slots, std::vector<MeshContact>& contacts,
                          const std::vector<const TriMesh*>& meshes, std::vector<double*>& history,
                          double* overflow);
+// Bit s set when slot s of `slots` holds a contact (a non-zero key).
+std::uint32_t live_slots(const double* slots);
+// Frees the slots of `live` (fills them with zeros); `live` becomes 0.
+void release_slots(double* slots, std::uint32_t& live);
 
 }  // namespace dem
