@@ -81,7 +81,9 @@ def shear_zone_check(case_dir: str | Path, slice_diameters: float = 0.5) -> Shea
     diameter = 2.0 * float(setup["reference_radius"])
     z_floor = float(record["readout"]["z_floor"])
     particles = read_vtk_particles(snapshot, arrays=["v"])
-    if "interior_r_lo" in setup and setup["interior_r_hi"] > 0.0:
+    # The annulus where the deck reads rho_b (bulk_density: interior), else the whole ring
+    # and a band two diameters high about the plane.
+    if setup.get("bulk_density") == "interior":
         r_lo, r_hi = float(setup["interior_r_lo"]), float(setup["interior_r_hi"])
         z_lo, z_hi = float(setup["interior_z_lo"]), float(setup["interior_z_hi"])
     else:
