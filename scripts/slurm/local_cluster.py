@@ -4,7 +4,9 @@ Writes ``/etc/slurm/slurm.conf`` (the Slurm job-step executor drops ``SLURM_CONF
 must be at the default path), makes sure a MUNGE key exists, starts ``munged`` (unless one
 already answers), ``slurmctld`` and ``slurmd`` in the foreground as child processes, waits until
 the node is idle, and stops exactly the processes it started, by their PIDs, removing the
-configuration again.
+configuration again. One cluster at a time: the process that started one holds a lock on
+``/var/lib/demcal-slurm/cluster.lock`` until it stops it (or exits), and a second start while
+it is held fails at once, instead of stopping the first one's daemons under its jobs.
 
 Finished jobs are appended to a job-completion log (``jobcomp/filetxt``) that
 :func:`parse_jobcomp` reads, because a cluster without ``slurmdbd`` has no ``sacct``.
@@ -19,6 +21,7 @@ Command line (as root)::
 from __future__ import annotations
 
 import argparse
+import fcntl
 import json
 import os
 import pwd
@@ -39,6 +42,7 @@ MARKER = "# demcal one-node Slurm cluster on localhost (scripts/slurm/local_clus
 STATE_DIR = Path("/var/lib/demcal-slurm")
 LOG_DIR = Path("/var/log/demcal-slurm")
 RECORD = STATE_DIR / "daemons.json"
+LOCK = STATE_DIR / "cluster.lock"
 MUNGE_KEY = Path("/etc/munge/munge.key")
 MUNGE_RUN_DIR = Path("/run/munge")
 INSTALL_SCRIPT = Path(__file__).resolve().with_name("install_slurm.sh")
@@ -104,6 +108,7 @@ class LocalCluster:
     jobcomp_log: Path
     pids: dict[str, int] = field(default_factory=dict)
     _procs: dict[str, subprocess.Popen] = field(default_factory=dict, repr=False)
+    _lock_fd: int | None = field(default=None, repr=False)
 
 
 def parse_node_hardware(text: str) -> NodeHardware:
@@ -343,6 +348,41 @@ def _launch(cluster: LocalCluster, name: str, cmd: list[str], **kwargs: Any) -> 
     _write_record(cluster)
 
 
+def _acquire_lock() -> int:
+    """Take the one-cluster lock without waiting; return its file descriptor.
+
+    The lock is the kernel's (``flock``), so it is released when its holder exits, however it
+    ends. The file names the holder's PID for the error message.
+
+    Raises
+    ------
+    ClusterError
+        If another process holds the lock, naming that process.
+    """
+    STATE_DIR.mkdir(parents=True, exist_ok=True)
+    fd = os.open(LOCK, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+        os.close(fd)
+        raise ClusterError(
+            f"a local Slurm cluster is already in use by process {holder} ({LOCK} is locked); "
+            "two test clusters would share /etc/slurm/slurm.conf and stop each other's daemons: "
+            "wait for that process to finish"
+        ) from None
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    return fd
+
+
+def _release_lock(cluster: LocalCluster) -> None:
+    """Release the one-cluster lock if ``cluster`` holds it."""
+    if cluster._lock_fd is not None:
+        os.close(cluster._lock_fd)
+        cluster._lock_fd = None
+
+
 def _write_record(cluster: LocalCluster) -> None:
     """Record the started daemons (PID and start time), so ``stop`` works from another process."""
     record = {
@@ -407,27 +447,32 @@ def start(timeout: float = 90.0) -> LocalCluster:
     Raises
     ------
     ClusterError
-        If the configuration belongs to another installation or a daemon does not come up
-        (the message carries the end of its log).
+        If another process's cluster is in use, the configuration belongs to another
+        installation or a daemon does not come up (the message carries the end of its log).
     """
     reason = unavailable_reason(install=False)
     if reason:
         raise ClusterError(reason)
-    for d in (STATE_DIR, STATE_DIR / "slurmctld", STATE_DIR / "slurmd", LOG_DIR):
-        d.mkdir(parents=True, exist_ok=True)
-    # Daemons left by an earlier start whose stop never ran: they are ours, stop them.
-    stop_recorded()
-
-    node = parse_node_hardware(
-        subprocess.run(
-            ["slurmd", "-C"], capture_output=True, text=True, check=True, env=_sbin_env()
-        ).stdout
-    )
+    lock_fd = _acquire_lock()
+    try:
+        for d in (STATE_DIR, STATE_DIR / "slurmctld", STATE_DIR / "slurmd", LOG_DIR):
+            d.mkdir(parents=True, exist_ok=True)
+        # Daemons left by an earlier start whose stop never ran (its holder is gone, or the
+        # lock would not be ours): they are ours, stop them.
+        stop_recorded()
+        node = parse_node_hardware(
+            subprocess.run(
+                ["slurmd", "-C"], capture_output=True, text=True, check=True, env=_sbin_env()
+            ).stdout
+        )
+    except BaseException:
+        os.close(lock_fd)
+        raise
     CONF_PATH.parent.mkdir(parents=True, exist_ok=True)
     CONF_PATH.write_text(render_slurm_conf(node))
     jobcomp = LOG_DIR / "jobcomp.log"
     jobcomp.write_text("")
-    cluster = LocalCluster(node=node, partition=PARTITION, jobcomp_log=jobcomp)
+    cluster = LocalCluster(node=node, partition=PARTITION, jobcomp_log=jobcomp, _lock_fd=lock_fd)
     try:
         if not _munge_works():
             uid, gid = _ensure_munge_key()
@@ -460,7 +505,7 @@ def start(timeout: float = 90.0) -> LocalCluster:
 def stop(cluster: LocalCluster) -> None:
     """Stop the daemons :func:`start` launched for ``cluster``, by PID, newest first.
 
-    Also removes the ``slurm.conf`` that :func:`start` wrote.
+    Also removes the ``slurm.conf`` that :func:`start` wrote and releases the one-cluster lock.
     """
     for name in reversed(list(cluster.pids)):
         proc = cluster._procs.get(name)
@@ -475,6 +520,7 @@ def stop(cluster: LocalCluster) -> None:
     cluster._procs.clear()
     RECORD.unlink(missing_ok=True)
     _remove_conf()
+    _release_lock(cluster)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -487,8 +533,13 @@ def main(argv: list[str] | None = None) -> int:
         if reason:
             print(f"cannot start a local Slurm cluster: {reason}", file=sys.stderr)
             return 1
-        cluster = start()
+        try:
+            cluster = start()
+        except ClusterError as err:
+            print(f"cannot start a local Slurm cluster: {err}", file=sys.stderr)
+            return 1
         # The daemons must outlive this command: forget the child handles, keep the record.
+        # Its lock goes with this process, so a later start stops them.
         print(
             f"node {cluster.node.name} idle in partition {cluster.partition}; daemons "
             + ", ".join(f"{n}={p}" for n, p in cluster.pids.items())

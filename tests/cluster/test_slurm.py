@@ -9,8 +9,11 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import re
 import shutil
+import subprocess
+import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -141,6 +144,28 @@ def test_site_settings_are_left_to_the_user():
 
 
 # ---- with a running cluster -----------------------------------------------------------------
+
+
+def test_second_start_is_refused_and_leaves_the_running_cluster_alone(slurm_cluster):
+    # Two test sessions on one machine share /etc/slurm/slurm.conf: a second start used to stop
+    # the first one's daemons and hang its jobs. It must fail at once, naming the holder.
+    res = subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "slurm" / "local_cluster.py"), "start"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert res.returncode == 1, res.stdout + res.stderr
+    assert f"already in use by process {os.getpid()}" in res.stderr
+    assert slurm_cluster.pids and all(local_cluster._alive(p) for p in slurm_cluster.pids.values())
+    assert local_cluster.MARKER in local_cluster.CONF_PATH.read_text()
+    idle = subprocess.run(
+        ["sinfo", "-h", "-n", slurm_cluster.node.name, "-o", "%T"],
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert idle.stdout.strip() == "idle"
 
 
 def test_slurm_profile_requests_reach_sbatch(slurm_cluster, probe_dir):
