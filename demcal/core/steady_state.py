@@ -47,7 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Plateau", "detect_plateau", "mser_truncation"]
+__all__ = ["Plateau", "batch_means_sem", "detect_plateau", "mser_truncation"]
 
 # Fewest samples for which a plateau is sought at all.
 _MIN_SAMPLES = 10
@@ -284,15 +284,28 @@ def _window_stats(
         end_time=float(t[stop - 1]),
         mean=float(np.mean(yw)),
         std=std,
-        sem=_batch_means_sem(yw),
+        sem=batch_means_sem(yw),
         drift=drift,
         steady=steady,
         reason=reason,
     )
 
 
-def _batch_means_sem(y: np.ndarray, max_batches: int = 20) -> float:
-    """Standard error of the mean of ``y`` from non-overlapping batch means."""
+def batch_means_sem(y: np.ndarray, max_batches: int = 20) -> float:
+    """Standard error of the mean of a correlated series from non-overlapping batch means.
+
+    Parameters
+    ----------
+    y : numpy.ndarray
+        Shape (n,), the series (any units).
+    max_batches : int
+        Most batches; fewer when ``n`` is small (at least two samples per batch).
+
+    Returns
+    -------
+    float
+        Standard error of ``y.mean()`` (units of ``y``); NaN with fewer than two batches.
+    """
     n = y.size
     n_batches = min(max_batches, n // 2)
     if n_batches < 2:

@@ -239,6 +239,33 @@ def test_upper_tube_force_enters_sigma() -> None:
     assert naive["mu_psh"].iloc[0] > 1.3 * CYCLES[0]["mu_psh"]
 
 
+def test_a_ringing_lid_does_not_raise_mu() -> None:
+    # A servo lid that rings: its force swings by +-60 % from one few-row stretch to the next
+    # while the bed carries a steady shear force (the quick ring at 1 068 Pa with mu_s 0.1
+    # read 0.49-0.87 by the mean of tau / sigma where its contacts gave 0.37-0.42). The readout
+    # is mean tau over mean sigma, which the swing leaves alone; the mean of the ratio does not.
+    table = synthetic_run(CYCLES[:1], seed=6)
+    pre = np.flatnonzero(table["phase"].to_numpy() == 1)
+    swing = np.where((np.arange(pre.size) // 3) % 2 == 0, 1.6, 0.4)
+    table.loc[pre, "lid_force"] = table.loc[pre, "lid_force"].to_numpy() * swing
+    got = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G).iloc[0]
+    assert got["steady_psh"]
+    series = shear_stress_series(table, R, Z_FLOOR, Z_SHEAR, G)
+    window = series[
+        (series["phase"] == 1)
+        & (series["time"] >= got["psh_t_start"])
+        & (series["time"] <= got["psh_t_end"])
+    ]
+    assert got["mu_psh"] == pytest.approx(window["tau"].mean() / window["sigma"].mean(), rel=1e-12)
+    assert window["mu"].mean() > 1.1 * CYCLES[0]["mu_psh"]
+    # The steady stretch's own mu: the shear force was built on the unswung normal force, whose
+    # mean the swing keeps to within the rows' pairing.
+    assert got["mu_psh"] == pytest.approx(CYCLES[0]["mu_psh"], rel=0.03)
+    assert 0.0 < got["mu_psh_sem"] < 0.01
+    # The shear phase, whose lid did not ring, reads as before.
+    assert got["mu_sh"] == pytest.approx(CYCLES[0]["mu_sh"], abs=0.005)
+
+
 def test_interrupted_run_flags_unsteady_and_missing_phases() -> None:
     spec = {"normal_stress": 10070.0, "P": 0.8, "mu_psh": 0.5, "mu_sh": 0.45, "rho_b": 1800.0}
     full = synthetic_run([spec, spec], seed=3)

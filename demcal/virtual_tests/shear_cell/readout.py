@@ -48,11 +48,15 @@ plane is the annulus ``A = pi (R^2 - R_i^2)`` at every travel, the normal force 
 ``N = lid_force + rho_b g A (lid_z - z_shear) + upper_force_z`` as above, and the torque, with
 the shear stress taken uniform over the plane, gives ``tau = 3 |torque| / (2 pi (R^3 - R_i^3))``.
 
-``mu_psh`` and ``mu_sh`` are the means of ``mu`` over the steady plateaus detected (by
-:func:`demcal.core.steady_state.detect_plateau`) in the pre-shear and the shear phase of a
-cycle;
-``rho_b`` is averaged over the pre-shear plateau. ``P`` is the ratio of the servo target forces
-of shear and pre-shear, and ``normal_stress`` the pre-shear target force over ``pi R^2``.
+The steady plateaus are detected in ``mu`` (by :func:`demcal.core.steady_state.detect_plateau`)
+in the pre-shear and the shear phase of a cycle; ``mu_psh`` and ``mu_sh`` are the mean shear
+stress over the plateau divided by its mean normal stress, as a tester's averaged forces give
+it, not the mean of ``mu`` itself: a servo lid that rings (its force swinging by half its
+value and more between print steps while the bed below carries a steady stress) makes the mean
+of the ratio read high, by a factor of up to two, while the ratio of the means keeps to the
+contacts across the plane. ``rho_b`` is averaged over the pre-shear plateau. ``P`` is the
+ratio of the servo target forces of shear and pre-shear, and ``normal_stress`` the pre-shear
+target force over ``pi R^2``.
 
 A phase whose servo did not hold the load gives no value: when the lid force averaged over the
 plateau lies outside :data:`LOAD_HELD` times the target force, ``mu`` (and for a pre-shear
@@ -78,7 +82,7 @@ import numpy as np
 import pandas as pd
 
 from demcal.core.parameters import GRAVITY
-from demcal.core.steady_state import Plateau, detect_plateau
+from demcal.core.steady_state import Plateau, batch_means_sem, detect_plateau
 from demcal.engine_io.output_errors import require_columns
 
 __all__ = [
@@ -315,6 +319,27 @@ def _phase_plateau(rows: pd.DataFrame, plateau_kwargs: dict[str, Any]) -> Platea
     return detect_plateau(t, rows["mu"].to_numpy(dtype=np.float64), **plateau_kwargs)
 
 
+def _stress_ratio(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None:
+    """The plateau with its mean and standard error those of mean tau / mean sigma over its
+    window (``rows`` as given to :func:`_phase_plateau`, with ``tau`` and ``sigma``).
+
+    The standard error is the ratio estimator's: the batch-means error of ``tau - r sigma``
+    over the mean of ``sigma``.
+    """
+    if plateau is None or not np.isfinite(plateau.mean):
+        return plateau
+    window = rows.iloc[plateau.start_index : plateau.end_index]
+    tau = window["tau"].to_numpy(dtype=np.float64)
+    sigma = window["sigma"].to_numpy(dtype=np.float64)
+    mean_sigma = float(sigma.mean())
+    if mean_sigma == 0.0:
+        return dataclasses.replace(plateau, mean=math.nan, sem=math.nan)
+    ratio = float(tau.mean()) / mean_sigma
+    return dataclasses.replace(
+        plateau, mean=ratio, sem=batch_means_sem(tau - ratio * sigma) / abs(mean_sigma)
+    )
+
+
 def _load_checked(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None:
     """The plateau, or a NaN one when the lid force over it left :data:`LOAD_HELD` x target
     (``rows`` as given to :func:`_phase_plateau`)."""
@@ -410,8 +435,12 @@ def shear_cell_bulk_values(
         pre = series[in_cycle & (series["phase"] == PHASE_PRE_SHEAR)]
         shear = series[in_cycle & (series["phase"] == PHASE_SHEAR)]
         pre_steps, shear_steps = _unique_steps(pre), _unique_steps(shear)
-        p_psh = _load_checked(pre_steps, _phase_plateau(pre_steps, plateau_kwargs))
-        p_sh = _load_checked(shear_steps, _phase_plateau(shear_steps, plateau_kwargs))
+        p_psh = _load_checked(
+            pre_steps, _stress_ratio(pre_steps, _phase_plateau(pre_steps, plateau_kwargs))
+        )
+        p_sh = _load_checked(
+            shear_steps, _stress_ratio(shear_steps, _phase_plateau(shear_steps, plateau_kwargs))
+        )
 
         target_pre = float(pre["target_force"].median()) if not pre.empty else np.nan
         target_sh = float(shear["target_force"].median()) if not shear.empty else np.nan
