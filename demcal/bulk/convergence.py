@@ -81,6 +81,11 @@ class Factor:
 #: Smallest cell the study renders (the configuration's min_dCylDp guards production runs).
 MIN_STUDY_DCYLDP = 4.0
 
+#: The heap-size levels' lift: height in tube diameters and speed in largest-particle
+#: diameters per second (the quick heap's: 1.2 D of dCylDp 9 in 4 s).
+LIFT_HEIGHT = 1.2
+LIFT_SPEED = 1.2 * 9.0 / 4.0
+
 
 def _levels(key: str, values: Sequence[float], **fixed: Any) -> tuple[dict[str, Any], ...]:
     return tuple({key: v, **{k.replace("__", "."): f for k, f in fixed.items()}} for v in values)
@@ -201,7 +206,18 @@ FACTORS: dict[str, Factor] = {
             "aor_dCylDp",
             "angle_of_repose",
             "cylinder diameter / largest particle diameter dCylDp",
-            _levels("angle_of_repose.dCylDp", (6, 9, 14, 20)),
+            tuple(
+                {
+                    "angle_of_repose.dCylDp": float(d),
+                    # The lift rises 1.2 D at the quick heap's speed (1.2 D in 4 s at dCylDp 9:
+                    # 2.7 largest diameters per second) at every size; with a fixed lift time
+                    # the tube would rise faster in wider cells, and a faster lift flattens the
+                    # heap (aor_lift_time), which a size study must not mix in.
+                    "angle_of_repose.lift_height": LIFT_HEIGHT,
+                    "angle_of_repose.lift_time": LIFT_HEIGHT * d / LIFT_SPEED,
+                }
+                for d in (6, 9, 14, 20)
+            ),
             "angle_of_repose.dCylDp",
         ),
         Factor(

@@ -153,6 +153,49 @@ def test_ring_width_levels_keep_height_and_travel_in_particle_sizes(tmp_path: Pa
     assert "shear_cell.geometry=ring" in str(planned[0][0].case_dir)
 
 
+def test_heap_size_levels_lift_at_the_quick_heaps_speed(tmp_path: Path) -> None:
+    # A fixed lift time would raise the tube faster in wider cells, and a faster lift flattens
+    # the heap: the size study would measure the lift speed too.
+    settings = load_config(ROOT / "config" / "config.yaml")
+    quick = plan_study(
+        settings,
+        {"a": SET},
+        [restrict_levels(FACTORS["aor_dCylDp"], [9.0])],
+        [1],
+        tmp_path / "quick",
+        "dem_engine -in {x}",
+        2029.0,
+    )
+    planned = plan_study(
+        settings,
+        {"a": SET},
+        [FACTORS["aor_dCylDp"]],
+        [1],
+        tmp_path / "all",
+        "dem_engine -in {x}",
+        2029.0,
+    )
+    quick_setup = json.loads((quick[0][0].case_dir / "case.json").read_text())["setup"]
+    # The level at the profile's dCylDp is the profile's own heap.
+    aor = settings["angle_of_repose"]
+    assert aor["dCylDp"] == 9
+    assert quick_setup["lift_distance"] == pytest.approx(
+        aor["lift_height"] * 2.0 * quick_setup["radius"]
+    )
+    assert quick_setup["lift_speed"] == pytest.approx(
+        quick_setup["lift_distance"] / aor["lift_time"]
+    )
+    speeds = []
+    for job, _, overrides in planned:
+        setup = json.loads((job.case_dir / "case.json").read_text())["setup"]
+        assert setup["radius"] == pytest.approx(
+            overrides["angle_of_repose.dCylDp"] * quick_setup["radius"] / 9.0
+        )
+        speeds.append(setup["lift_speed"])
+    assert len(speeds) == 4
+    assert speeds == pytest.approx([quick_setup["lift_speed"]] * 4, rel=1e-9)
+
+
 def test_every_factor_level_renders_on_the_quick_profile(tmp_path: Path) -> None:
     # The study runs on config/config.yaml; a level that pins the split cell must also pin a
     # cycle mode the split cell can run (the quick ring continues, a split cell cannot).
