@@ -84,7 +84,7 @@ MIN_STUDY_DCYLDP = 4.0
 #: The heap-size levels' lift: height in tube diameters and speed in largest-particle
 #: diameters per second (the quick heap's: 1.2 D of dCylDp 9 in 4 s).
 LIFT_HEIGHT = 1.2
-LIFT_SPEED = 1.2 * 9.0 / 4.0
+LIFT_SPEED = LIFT_HEIGHT * 9.0 / 4.0
 
 
 def _levels(key: str, values: Sequence[float], **fixed: Any) -> tuple[dict[str, Any], ...]:

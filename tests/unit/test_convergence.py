@@ -157,28 +157,19 @@ def test_heap_size_levels_lift_at_the_quick_heaps_speed(tmp_path: Path) -> None:
     # A fixed lift time would raise the tube faster in wider cells, and a faster lift flattens
     # the heap: the size study would measure the lift speed too.
     settings = load_config(ROOT / "config" / "config.yaml")
-    quick = plan_study(
-        settings,
-        {"a": SET},
-        [restrict_levels(FACTORS["aor_dCylDp"], [9.0])],
-        [1],
-        tmp_path / "quick",
-        "dem_engine -in {x}",
-        2029.0,
-    )
     planned = plan_study(
-        settings,
-        {"a": SET},
-        [FACTORS["aor_dCylDp"]],
-        [1],
-        tmp_path / "all",
-        "dem_engine -in {x}",
-        2029.0,
+        settings, {"a": SET}, [FACTORS["aor_dCylDp"]], [1], tmp_path, "dem_engine -in {x}", 2029.0
     )
-    quick_setup = json.loads((quick[0][0].case_dir / "case.json").read_text())["setup"]
+    setups = {
+        overrides["angle_of_repose.dCylDp"]: json.loads((job.case_dir / "case.json").read_text())[
+            "setup"
+        ]
+        for job, _, overrides in planned
+    }
     # The level at the profile's dCylDp is the profile's own heap.
     aor = settings["angle_of_repose"]
     assert aor["dCylDp"] == 9
+    quick_setup = setups[9.0]
     assert quick_setup["lift_distance"] == pytest.approx(
         aor["lift_height"] * 2.0 * quick_setup["radius"]
     )
@@ -186,11 +177,8 @@ def test_heap_size_levels_lift_at_the_quick_heaps_speed(tmp_path: Path) -> None:
         quick_setup["lift_distance"] / aor["lift_time"]
     )
     speeds = []
-    for job, _, overrides in planned:
-        setup = json.loads((job.case_dir / "case.json").read_text())["setup"]
-        assert setup["radius"] == pytest.approx(
-            overrides["angle_of_repose.dCylDp"] * quick_setup["radius"] / 9.0
-        )
+    for d_cyl, setup in setups.items():
+        assert setup["radius"] == pytest.approx(d_cyl * quick_setup["radius"] / 9.0)
         speeds.append(setup["lift_speed"])
     assert len(speeds) == 4
     assert speeds == pytest.approx([quick_setup["lift_speed"]] * 4, rel=1e-9)
