@@ -200,8 +200,19 @@ def write_case_rows(
 ) -> None:
     """Extract the bulk rows of one case (directory of ``info``, see :func:`case_rows`) and
     write them as CSV with a provenance sidecar (``<path>.json``); logs to ``log``."""
-    with rule_log(log):
+    with rule_log(log) as logger:
         rows = case_rows(test, Path(info).parent, extract, p_values)
+        for phase in ("psh", "sh"):
+            flag = f"{phase}_lid_rings"
+            if flag in rows and rows[flag].fillna(False).astype(bool).any():
+                cycles = rows.loc[rows[flag].fillna(False).astype(bool), "cycle"].tolist()
+                logger.warning(
+                    "%s: the servo lid rings in the %s of cycles %s (its force alternates "
+                    "between print steps): lower shear_cell.servo_kp",
+                    Path(info).parent,
+                    "pre-shear" if phase == "psh" else "shear",
+                    cycles,
+                )
         rows.to_csv(path, index=False, float_format="%.10g")
         write_sidecar(path, config, seed=int(config["seed"]), extra={"rows": len(rows)})
 

@@ -13,6 +13,7 @@ from demcal.engine_io.output_errors import MissingColumnError
 from demcal.virtual_tests.shear_cell.readout import (
     INTERIOR_MASS_COLUMN,
     REQUIRED_COLUMNS,
+    lid_rings,
     overlap_area,
     shear_cell_bulk_values,
     shear_stress_series,
@@ -264,6 +265,32 @@ def test_a_ringing_lid_does_not_raise_mu() -> None:
     assert 0.0 < got["mu_psh_sem"] < 0.01
     # The shear phase, whose lid did not ring, reads as before.
     assert got["mu_sh"] == pytest.approx(CYCLES[0]["mu_sh"], abs=0.005)
+
+
+def test_a_lid_alternating_between_print_steps_is_flagged() -> None:
+    # A servo oscillating at every time step, printed at an odd interval: the lid force
+    # alternates between two values from one row to the next (quick ring, 1 068 Pa, mu_s 0.1:
+    # by 70-90 % of its mean). The flag marks that phase only; a slow swing or noise does not
+    # count, and the values are the ratio of means as before.
+    table = synthetic_run(CYCLES[:1], seed=6)
+    quiet = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G).iloc[0]
+    assert not quiet["psh_lid_rings"] and not quiet["sh_lid_rings"]
+    pre = np.flatnonzero(table["phase"].to_numpy() == 1)
+    alternate = np.where(np.arange(pre.size) % 2 == 0, 1.7, 0.3)
+    table.loc[pre, "lid_force"] = table.loc[pre, "lid_force"].to_numpy() * alternate
+    got = shear_cell_bulk_values(table, R, Z_FLOOR, Z_SHEAR, G).iloc[0]
+    assert got["psh_lid_rings"] and not got["sh_lid_rings"]
+    assert got["steady_psh"]
+    assert got["mu_psh"] == pytest.approx(CYCLES[0]["mu_psh"], rel=0.03)
+    rng = np.random.default_rng(1)
+    force = 3.0 * (1.0 + 0.02 * rng.standard_normal(200))
+    assert not lid_rings(force)
+    assert lid_rings(force * np.where(np.arange(200) % 2 == 0, 1.5, 0.5))
+    # Alternating by a few per cent only (print noise at a quiet lid) is no ringing.
+    assert not lid_rings(3.0 * np.where(np.arange(200) % 2 == 0, 1.05, 0.95))
+    # A swing over several rows (period 6) is not an alternation.
+    assert not lid_rings(3.0 * np.where((np.arange(200) // 3) % 2 == 0, 1.6, 0.4))
+    assert not lid_rings(np.array([1.0, 2.0, 1.0])) and not lid_rings(np.zeros(10))
 
 
 def test_interrupted_run_flags_unsteady_and_missing_phases() -> None:

@@ -58,6 +58,17 @@ mu_s 0.1), while the ratio of the means keeps to the contacts across the plane. 
 averaged over the pre-shear plateau. ``P`` is the ratio of the servo target forces of shear
 and pre-shear, and ``normal_stress`` the pre-shear target force over ``pi R^2``.
 
+The lid's servo is a proportional controller acting once per time step, and the contacts'
+damping feeds the lid's own speed straight back into the force it reads; with too high a gain
+(``shear_cell.servo_kp``) for a heavy, strongly damped bed at low stress the lid's speed flips
+sign every step and its force alternates between two values (in the quick ring at 1 068 Pa
+with mu_s 0.1, rho_p 3 500 kg/m^3 and COR 0.5: a coefficient of variation of 67-88 % at kp 1,
+not at 0.5 or 0.25, in both codes). The ratio of means reads such a phase within a few per
+cent, but the bed is being shaken, so ``psh_lid_rings`` and ``sh_lid_rings`` flag it
+(:func:`lid_rings`: the lid force over the plateau alternating from one print step to the
+next, lag-one autocorrelation below :data:`RINGING_AUTOCORRELATION`, by more than
+:data:`RINGING_CV` of its mean); the remedy is a lower ``servo_kp``.
+
 A phase whose servo did not hold the load gives no value: when the lid force averaged over the
 plateau lies outside :data:`LOAD_HELD` times the target force, ``mu`` (and for a pre-shear
 ``rho_b``) is NaN, the phase is not steady and its reason says so. With a strongly cohesive bed
@@ -93,7 +104,10 @@ __all__ = [
     "PHASE_SHEAR",
     "PHASE_UNLOAD",
     "REQUIRED_COLUMNS",
+    "RINGING_AUTOCORRELATION",
+    "RINGING_CV",
     "RING_COLUMNS",
+    "lid_rings",
     "overlap_area",
     "required_columns",
     "shear_cell_bulk_values",
@@ -141,6 +155,13 @@ _SOURCE = "shear-cell table"
 #: normal load. Sound runs stay within 0.87-1.35 (tiny cell, strong rolling resistance) and
 #: 0.93-1.08 (quick cell); runs whose servo lost the load read -1.7 to 0.25 or 2.0 to 3.3.
 LOAD_HELD = (0.5, 1.5)
+
+#: A lid force whose lag-one autocorrelation over a plateau is below this alternates between
+#: print steps (a servo oscillating at every time step, read at an odd print interval): ringing
+#: lids read -0.98 to -1.0, quiet ones +0.7 to +0.95 (quick ring, 2026-12-07).
+RINGING_AUTOCORRELATION = -0.5
+#: ... and swings by more than this fraction of its mean (ringing 0.67-0.88, quiet <= 0.04).
+RINGING_CV = 0.2
 
 
 def _cross_section(radius: float, inner_radius: float | None) -> float:
@@ -340,6 +361,41 @@ def _stress_ratio(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None
     )
 
 
+def lid_rings(lid_force: np.ndarray) -> bool:
+    """Whether a lid force series alternates from one print step to the next.
+
+    Parameters
+    ----------
+    lid_force : numpy.ndarray
+        Shape (n,), the lid force at consecutive print steps of one plateau, N.
+
+    Returns
+    -------
+    bool
+        True when its lag-one autocorrelation is below :data:`RINGING_AUTOCORRELATION` and its
+        standard deviation above :data:`RINGING_CV` times its mean; False for fewer than four
+        values or a non-positive mean.
+    """
+    force = np.asarray(lid_force, dtype=np.float64)
+    mean = float(force.mean()) if force.size else math.nan
+    if force.size < 4 or not mean > 0.0:
+        return False
+    deviation = force - mean
+    variance = float(deviation @ deviation)
+    if variance == 0.0:
+        return False
+    lag_one = float(deviation[:-1] @ deviation[1:]) / variance
+    return lag_one < RINGING_AUTOCORRELATION and float(force.std()) > RINGING_CV * mean
+
+
+def _rings(rows: pd.DataFrame, plateau: Plateau | None) -> bool:
+    """:func:`lid_rings` over the plateau's window of ``rows`` (False without a plateau)."""
+    if plateau is None or plateau.end_index <= plateau.start_index:
+        return False
+    window = rows.iloc[plateau.start_index : plateau.end_index]
+    return lid_rings(window["lid_force"].to_numpy(dtype=np.float64))
+
+
 def _load_checked(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None:
     """The plateau, or a NaN one when the lid force over it left :data:`LOAD_HELD` x target
     (``rows`` as given to :func:`_phase_plateau`)."""
@@ -401,8 +457,9 @@ def shear_cell_bulk_values(
         ``rho_b_cell`` (kg/m^3, the whole cell's; equal to ``rho_b`` without an interior
         region), ``steady_psh``, ``steady_sh`` (bool), the plateau windows ``psh_t_start``,
         ``psh_t_end``, ``sh_t_start``, ``sh_t_end`` (s), the standard errors ``mu_psh_sem``,
-        ``mu_sh_sem`` (-) and the detector's ``psh_reason``, ``sh_reason``. Values of a
-        missing phase are NaN and its steady flag is False.
+        ``mu_sh_sem`` (-), the detector's ``psh_reason``, ``sh_reason`` and the flags
+        ``psh_lid_rings``, ``sh_lid_rings`` (bool, :func:`lid_rings` over the plateau). Values
+        of a missing phase are NaN and its steady and ringing flags are False.
 
     Raises
     ------
@@ -435,12 +492,10 @@ def shear_cell_bulk_values(
         pre = series[in_cycle & (series["phase"] == PHASE_PRE_SHEAR)]
         shear = series[in_cycle & (series["phase"] == PHASE_SHEAR)]
         pre_steps, shear_steps = _unique_steps(pre), _unique_steps(shear)
-        p_psh = _load_checked(
-            pre_steps, _stress_ratio(pre_steps, _phase_plateau(pre_steps, plateau_kwargs))
-        )
-        p_sh = _load_checked(
-            shear_steps, _stress_ratio(shear_steps, _phase_plateau(shear_steps, plateau_kwargs))
-        )
+        found_psh = _phase_plateau(pre_steps, plateau_kwargs)
+        found_sh = _phase_plateau(shear_steps, plateau_kwargs)
+        p_psh = _load_checked(pre_steps, _stress_ratio(pre_steps, found_psh))
+        p_sh = _load_checked(shear_steps, _stress_ratio(shear_steps, found_sh))
 
         target_pre = float(pre["target_force"].median()) if not pre.empty else np.nan
         target_sh = float(shear["target_force"].median()) if not shear.empty else np.nan
@@ -474,6 +529,8 @@ def shear_cell_bulk_values(
                 "mu_sh_sem": p_sh.sem if p_sh else np.nan,
                 "psh_reason": p_psh.reason if p_psh else "no pre-shear phase",
                 "sh_reason": p_sh.reason if p_sh else "no shear phase",
+                "psh_lid_rings": _rings(pre_steps, found_psh),
+                "sh_lid_rings": _rings(shear_steps, found_sh),
             }
         )
     columns = [
@@ -494,5 +551,7 @@ def shear_cell_bulk_values(
         "mu_sh_sem",
         "psh_reason",
         "sh_reason",
+        "psh_lid_rings",
+        "sh_lid_rings",
     ]
     return pd.DataFrame.from_records(records, columns=columns)
