@@ -190,6 +190,35 @@ def training_rows(data: pd.DataFrame, test: str, output: str) -> pd.DataFrame:
     return collapse_shared_loads(rows, output)
 
 
+def ringing_notes(rows: pd.DataFrame) -> list[str]:
+    """What a case's shear-cell rows say about a ringing servo lid, one note per phase kind.
+
+    Parameters
+    ----------
+    rows : DataFrame
+        The rows of one case (:func:`case_rows`); ``psh_lid_rings`` and ``sh_lid_rings``
+        (bool, see :func:`demcal.virtual_tests.shear_cell.readout.lid_rings`) and ``cycle``
+        where present.
+
+    Returns
+    -------
+    list of str
+        Empty when no phase rang (or the rows have no such flags).
+    """
+    notes = []
+    for flag, phase in (("psh_lid_rings", "pre-shear"), ("sh_lid_rings", "shear")):
+        if flag not in rows:
+            continue
+        rang = rows[flag].astype("boolean").fillna(False).to_numpy(dtype=bool)
+        if rang.any():
+            cycles = ", ".join(str(int(c)) for c in rows.loc[rang, "cycle"])
+            notes.append(
+                f"the servo lid rings in the {phase} of cycle(s) {cycles} (its force "
+                "alternates between print steps, shaking the bed): lower shear_cell.servo_kp"
+            )
+    return notes
+
+
 def write_case_rows(
     test: str,
     info: str | Path,
@@ -202,17 +231,8 @@ def write_case_rows(
     write them as CSV with a provenance sidecar (``<path>.json``); logs to ``log``."""
     with rule_log(log) as logger:
         rows = case_rows(test, Path(info).parent, extract, p_values)
-        for phase in ("psh", "sh"):
-            flag = f"{phase}_lid_rings"
-            if flag in rows and rows[flag].fillna(False).astype(bool).any():
-                cycles = rows.loc[rows[flag].fillna(False).astype(bool), "cycle"].tolist()
-                logger.warning(
-                    "%s: the servo lid rings in the %s of cycles %s (its force alternates "
-                    "between print steps): lower shear_cell.servo_kp",
-                    Path(info).parent,
-                    "pre-shear" if phase == "psh" else "shear",
-                    cycles,
-                )
+        for note in ringing_notes(rows):
+            logger.warning("%s: %s", Path(info).parent, note)
         rows.to_csv(path, index=False, float_format="%.10g")
         write_sidecar(path, config, seed=int(config["seed"]), extra={"rows": len(rows)})
 

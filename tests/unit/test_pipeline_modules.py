@@ -11,7 +11,14 @@ import pytest
 import torch
 import yaml
 
-from demcal.bulk.dataset import case_rows, collect, replicate_means, training_rows, usable
+from demcal.bulk.dataset import (
+    case_rows,
+    collect,
+    replicate_means,
+    ringing_notes,
+    training_rows,
+    usable,
+)
 from demcal.core.config import ConfigError, validate_config
 from demcal.core.experiments import Experiment, MeasuredCondition, load_experiment
 from demcal.design.cases import (
@@ -176,6 +183,24 @@ def test_case_rows_ok_and_failed(tmp_path):
     data = collect([ok, bad])
     assert list(data.columns[:3]) == ["test", "case_id", "design_id"]
     assert len(usable(data, "mu_psh")) == 2
+
+
+def test_ringing_notes_name_the_phase_cycles_and_remedy():
+    rows = pd.DataFrame(
+        {
+            "cycle": [0, 1, 2, 3],
+            "psh_lid_rings": [True, True, False, True],
+            "sh_lid_rings": [False, False, False, False],
+        }
+    )
+    (note,) = ringing_notes(rows)
+    assert "pre-shear of cycle(s) 0, 1, 3" in note and "servo_kp" in note
+    rows["sh_lid_rings"] = [False, False, True, np.nan]
+    assert len(ringing_notes(rows)) == 2 and "shear of cycle(s) 2 " in ringing_notes(rows)[1]
+    quiet = rows.assign(psh_lid_rings=False, sh_lid_rings=False)
+    assert ringing_notes(quiet) == []
+    # A failed case has no flags: nothing to say.
+    assert ringing_notes(pd.DataFrame({"case_id": ["c0001"], "mu_psh": [np.nan]})) == []
 
 
 def test_replicate_runs_train_as_their_mean(tmp_path):
