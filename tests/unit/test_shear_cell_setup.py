@@ -370,6 +370,17 @@ def test_print_interval_gives_the_requested_samples() -> None:
     assert n_psh // s.print_every < 200
 
 
+@pytest.mark.parametrize("samples", [20, 99, 100, 137, 200, 250])
+def test_print_interval_is_odd(samples: int) -> None:
+    # A lid force oscillating at every time step must alternate between print rows (so that
+    # the ringing flag sees it), not be printed at one phase of its swing.
+    s, _, _ = setup_for(samples_per_preshear=samples)
+    n_psh = s.cycles[0].preshear_end_step - s.cycles[0].preshear_start_step
+    assert s.print_every % 2 == 1
+    assert n_psh // s.print_every >= samples
+    assert s.print_every >= n_psh // samples - 1
+
+
 def test_servo_speed_above_skin_limit_names_the_key() -> None:
     with pytest.raises(SetupError, match=r"shear_cell\.servo_speed"):
         setup_for(servo_speed=1e6)

@@ -292,6 +292,14 @@ class ShearCellSetup(RunSetup):
         return out
 
 
+def _odd_at_most(steps: int) -> int:
+    """The largest odd number of steps not above ``steps`` (>= 1): a lid oscillating at every
+    time step then alternates between print rows, where an even interval would print it at one
+    phase of the swing only, a constant offset that neither the readout nor its ringing flag
+    could see."""
+    return steps if steps % 2 else max(1, steps - 1)
+
+
 def _p_values(values: Sequence[Any]) -> list[float]:
     ps = [float(p) for p in values]
     if not ps:
@@ -535,7 +543,7 @@ def shear_cell_setup(
         fill_steps=fill_steps,
         segments=schedule.segments,
         cycles=cycles,
-        print_every=max(1, n_psh // samples),
+        print_every=_odd_at_most(max(1, n_psh // samples)),
         thermo_every=max(1, (schedule.end_step - fill_steps) // 50),
         snapshot_step=cycles[0].preshear_end_step,
         total_steps=schedule.end_step,
