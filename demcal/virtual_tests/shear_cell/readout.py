@@ -340,6 +340,11 @@ def _phase_plateau(rows: pd.DataFrame, plateau_kwargs: dict[str, Any]) -> Platea
     return detect_plateau(t, rows["mu"].to_numpy(dtype=np.float64), **plateau_kwargs)
 
 
+def _window(rows: pd.DataFrame, plateau: Plateau) -> pd.DataFrame:
+    """The rows of ``plateau``'s window (``rows`` as given to :func:`_phase_plateau`)."""
+    return rows.iloc[plateau.start_index : plateau.end_index]
+
+
 def _stress_ratio(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None:
     """The plateau with its mean and standard error those of mean tau / mean sigma over its
     window (``rows`` as given to :func:`_phase_plateau`, with ``tau`` and ``sigma``).
@@ -349,7 +354,7 @@ def _stress_ratio(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None
     """
     if plateau is None or not np.isfinite(plateau.mean):
         return plateau
-    window = rows.iloc[plateau.start_index : plateau.end_index]
+    window = _window(rows, plateau)
     tau = window["tau"].to_numpy(dtype=np.float64)
     sigma = window["sigma"].to_numpy(dtype=np.float64)
     mean_sigma = float(sigma.mean())
@@ -377,8 +382,10 @@ def lid_rings(lid_force: np.ndarray) -> bool:
         values or a non-positive mean.
     """
     force = np.asarray(lid_force, dtype=np.float64)
-    mean = float(force.mean()) if force.size else math.nan
-    if force.size < 4 or not mean > 0.0:
+    if force.size < 4:
+        return False
+    mean = float(force.mean())
+    if not mean > 0.0:
         return False
     deviation = force - mean
     variance = float(deviation @ deviation)
@@ -390,10 +397,9 @@ def lid_rings(lid_force: np.ndarray) -> bool:
 
 def _rings(rows: pd.DataFrame, plateau: Plateau | None) -> bool:
     """:func:`lid_rings` over the plateau's window of ``rows`` (False without a plateau)."""
-    if plateau is None or plateau.end_index <= plateau.start_index:
+    if plateau is None or plateau.n_samples <= 0:
         return False
-    window = rows.iloc[plateau.start_index : plateau.end_index]
-    return lid_rings(window["lid_force"].to_numpy(dtype=np.float64))
+    return lid_rings(_window(rows, plateau)["lid_force"].to_numpy(dtype=np.float64))
 
 
 def _load_checked(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None:
@@ -401,7 +407,7 @@ def _load_checked(rows: pd.DataFrame, plateau: Plateau | None) -> Plateau | None
     (``rows`` as given to :func:`_phase_plateau`)."""
     if plateau is None or not np.isfinite(plateau.mean):
         return plateau
-    window = rows.iloc[plateau.start_index : plateau.end_index]
+    window = _window(rows, plateau)
     target = float(window["target_force"].median())
     ratio = float(window["lid_force"].mean()) / target if target > 0.0 else math.nan
     low, high = LOAD_HELD
@@ -506,7 +512,7 @@ def shear_cell_bulk_values(
             )
         rho_b = rho_b_cell = np.nan
         if p_psh is not None and np.isfinite(p_psh.mean):
-            plateau = pre_steps.iloc[p_psh.start_index : p_psh.end_index]
+            plateau = _window(pre_steps, p_psh)
             rho_b = rho_b_cell = float(plateau["rho_b"].mean())
             if interior_volume is not None:
                 rho_b = float(plateau["rho_b_interior"].mean())
