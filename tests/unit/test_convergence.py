@@ -166,19 +166,20 @@ def test_heap_size_levels_lift_at_the_quick_heaps_speed(tmp_path: Path) -> None:
         ]
         for job, _, overrides in planned
     }
-    # The level at the profile's dCylDp is the profile's own heap.
+    # The level at the profile's dCylDp is the profile's own heap (its lift time, 6.22 s, is
+    # the level's 1.2 x 14 / 2.7 s rounded: the speed within 0.04 %).
     aor = settings["angle_of_repose"]
-    assert aor["dCylDp"] == 9
-    quick_setup = setups[9.0]
+    assert aor["dCylDp"] == 14
+    quick_setup = setups[14.0]
     assert quick_setup["lift_distance"] == pytest.approx(
         aor["lift_height"] * 2.0 * quick_setup["radius"]
     )
     assert quick_setup["lift_speed"] == pytest.approx(
-        quick_setup["lift_distance"] / aor["lift_time"]
+        quick_setup["lift_distance"] / aor["lift_time"], rel=1e-3
     )
     speeds = []
     for d_cyl, setup in setups.items():
-        assert setup["radius"] == pytest.approx(d_cyl * quick_setup["radius"] / 9.0)
+        assert setup["radius"] == pytest.approx(d_cyl * quick_setup["radius"] / 14.0)
         speeds.append(setup["lift_speed"])
     assert len(speeds) == 4
     assert speeds == pytest.approx([quick_setup["lift_speed"]] * 4, rel=1e-9)
