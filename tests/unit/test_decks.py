@@ -516,7 +516,7 @@ def test_particle_steps_are_the_rendered_decks_and_rank_runs_by_cost(tmp_path: P
     shear = particle_steps("shear_cell", {**CASE, "P": 1.0}, tiny())
     assert 3.0 < heap / shear < 6.0
     # Quick profile: the ring decks take longer the higher the stress (stiffer particles,
-    # smaller time step: 125 / 155 / 270 s of CPU, 2026-12-07). The heap of dCylDp 14 has more
+    # smaller time step: 84 / 132 / 263 s of CPU, 2026-12-07). The heap of dCylDp 14 has more
     # particle-steps than any (cheaper ones, 141 s), so the heaps start first, then the decks
     # from the highest stress down, and the shortest decks end the design.
     quick = load_config(ROOT / "config" / "config.yaml")
