@@ -6,7 +6,12 @@ engine), so that the measurements come from another code than the model under ca
 Usage: python scripts/make_synthetic_experiment.py --config config/tiny.yaml \\
     --truth config/experiments/truth/synthetic_reference.yaml \\
     --out config/experiments/synthetic_reference_tiny.yaml [--noise 0.01] [--seed 1] \\
-    [--truth-engine "liggghts -in {deck}"] [--normal-stresses 2029]
+    [--truth-engine "liggghts -in {deck}"] [--normal-stresses 2029] [--replicates 4] \\
+    [--work-dir DIR] [--workers 2]
+
+Each value is the mean of --replicates runs from fresh packings (as a laboratory repeats a
+test), its sd their standard error combined with the added noise. Runs kept in --work-dir are
+read back when the set is made again, so an interrupted set resumes.
 """
 
 import argparse
@@ -38,7 +43,14 @@ def main() -> None:
         help="command template of the truth runs (default: 'liggghts -in {deck}' when "
         "LIGGGHTS is installed, else the profile's engine)",
     )
+    parser.add_argument(
+        "--replicates", type=int, default=1, help="truth runs per test, from fresh packings"
+    )
+    parser.add_argument("--work-dir", default=None, help="where the truth runs are kept")
+    parser.add_argument("--workers", type=int, default=1, help="truth runs at the same time")
     args = parser.parse_args()
+    if args.replicates < 1 or args.workers < 1:
+        parser.error("--replicates and --workers must be at least 1")
     write_synthetic_experiment(
         args.config,
         args.truth,
@@ -51,6 +63,9 @@ def main() -> None:
         normal_stresses=(
             [float(s) for s in args.normal_stresses.split(",")] if args.normal_stresses else None
         ),
+        replicates=args.replicates,
+        work_dir=args.work_dir,
+        workers=args.workers,
     )
     print(f"wrote {args.out}")
 

@@ -41,15 +41,12 @@ from typing import Any
 import pandas as pd
 import yaml
 
+from demcal.bulk.synthetic import replicate_record
 from demcal.core.config import validate_config
 from demcal.core.experiments import load_experiment
 from demcal.core.snakemake_run import run_snakemake
 from demcal.discrepancy.candidates import deep_merge
-from demcal.discrepancy.synthetic import (
-    hidden_effect_bulk,
-    replicate_record,
-    write_truth,
-)
+from demcal.discrepancy.synthetic import hidden_effect_bulk, write_truth
 from demcal.discrepancy.truths import DrawnTruth, draw_truth, load_truth_spec
 from demcal.engine_io.run import installed_liggghts
 from demcal.sequential.comparison import (

@@ -1,12 +1,16 @@
-"""Synthetic "measured" data: the engine run at known parameters, optionally with noise.
+"""Synthetic "measured" data: the virtual tests run at known parameters, optionally with noise.
 
 The true parameters live in a file that the workflow never reads, so that tests can check that
-the identification recovers them.
+the identification recovers them. As a laboratory repeats a test, the stated value is the mean
+of replicate runs from fresh packings, and its sd covers their scatter: one quick shear-cell run
+scatters by 3-4 % in the friction values, as much as the acceptance tolerance.
 """
 
 import json
+import math
 import tempfile
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -22,19 +26,56 @@ from demcal.virtual_tests.deck import render_case
 
 
 def simulate_reference(
-    parameters: Mapping[str, float], config: Mapping[str, Any], work_dir: str | Path
+    parameters: Mapping[str, float],
+    config: Mapping[str, Any],
+    work_dir: str | Path,
+    replicates: int = 1,
+    workers: int = 1,
 ) -> pd.DataFrame:
-    """Bulk values of both virtual tests at ``parameters`` (tidy rows; raises if a run fails)."""
+    """Bulk values of both virtual tests at ``parameters``.
+
+    Parameters
+    ----------
+    parameters : mapping
+        Contact parameters (SI units) by name.
+    config : mapping
+        Validated configuration the tests run with.
+    work_dir : path
+        Where the runs are made; runs that finished there earlier are read back.
+    replicates : int
+        Repetitions of every run, the r-th (from 0) with the configuration seed + r (a fresh
+        packing); column ``replicate`` numbers them.
+    workers : int
+        Runs at the same time.
+
+    Returns
+    -------
+    DataFrame
+        Tidy bulk-value rows with ``test`` and ``replicate`` columns.
+
+    Raises
+    ------
+    RuntimeError
+        When a run fails (names its directory).
+    """
     work_dir = Path(work_dir)
-    frames = []
-    cases: list[tuple[str, dict]] = [("angle_of_repose", {"case_id": "reference", **parameters})]
-    for suffix in shear_suffixes(config):
-        key = f"reference{suffix}"
-        cases.append(("shear_cell", {"case_id": key, **parameters, **load_condition(config, key)}))
-    for test, case in cases:
-        frames.append(
-            run_case_bulk(test, case, config, work_dir / test / case["case_id"], "reference run")
-        )
+    cases: list[tuple[str, dict, int]] = []
+    for r in range(int(replicates)):
+        cases.append(("angle_of_repose", {"case_id": f"reference{r}", **parameters}, r))
+        for suffix in shear_suffixes(config):
+            key = f"reference{r}{suffix}"
+            load = load_condition(config, f"reference{suffix}")
+            cases.append(("shear_cell", {"case_id": key, **parameters, **load}, r))
+
+    def run(item: tuple[str, dict, int]) -> pd.DataFrame:
+        test, case, r = item
+        run_config = {**config, "seed": int(config["seed"]) + r}
+        rows = run_case_bulk(test, case, run_config, work_dir / test / case["case_id"], "run")
+        rows["replicate"] = r
+        return rows
+
+    with ThreadPoolExecutor(max_workers=max(1, int(workers))) as pool:
+        frames = list(pool.map(run, cases))
     return pd.concat(frames, ignore_index=True)
 
 
@@ -90,54 +131,73 @@ def run_case_bulk(
     return rows
 
 
-def experiment_record(
+def replicate_record(
     bulk: pd.DataFrame,
     material: str,
-    noise: float,
+    noise: Mapping[str, float],
     seed: int,
     source: str,
-    observables: tuple[str, ...] = ("mu_psh", "mu_sh", "rho_b"),
-    p_values: tuple[float, ...] | None = None,
+    observables: Sequence[str] = ("mu_psh", "mu_sh", "rho_b"),
+    p_values: Sequence[float] | None = None,
 ) -> dict[str, Any]:
-    """An experiment-file mapping from reference bulk values, with relative Gaussian noise.
+    """An experiment-file mapping: the mean of the replicates with its standard deviation.
+
+    Every value is the mean over the n replicate runs times (1 + noise_k * N(0, 1)); its sd is
+    sqrt(s^2 / n + (noise_k * mean)^2) with s the sample standard deviation of the replicates (0
+    for a single run): the standard error of the mean combined with the added noise, the
+    uncertainty of the value that is stated.
 
     Parameters
     ----------
     bulk : DataFrame
-        Output of :func:`simulate_reference`.
-    noise : float
-        Relative standard deviation of the measurement noise (e.g. 0.01), also written as sd.
-    observables : tuple of str
+        Output of :func:`simulate_reference` (or
+        :func:`demcal.discrepancy.synthetic.hidden_effect_bulk`): bulk rows with ``test`` and
+        ``replicate`` columns.
+    noise : mapping
+        Relative standard deviation of the added noise per observable (``mu_psh``, ``mu_sh``,
+        ``rho_b``, ``aor``; a missing one gets none).
+    observables : sequence of str
         Shear-cell readings to keep (partial data, as a real test may give).
-    p_values : tuple of float, optional
+    p_values : sequence of float, optional
         Shear load fractions to keep; all when None.
     """
     rng = np.random.default_rng(seed)
 
-    def noisy(value: float) -> float:
-        return float(value * (1.0 + noise * rng.standard_normal())) if noise > 0 else float(value)
+    def measured(values: pd.Series, name: str) -> tuple[float, float]:
+        vals = values.dropna().to_numpy(float)
+        mean = float(vals.mean())
+        scatter = float(vals.std(ddof=1) / math.sqrt(vals.size)) if vals.size > 1 else 0.0
+        level = float(noise.get(name, 0.0))
+        value = mean * (1.0 + level * rng.standard_normal()) if level > 0 else mean
+        return value, math.hypot(scatter, level * mean)
 
     record: dict[str, Any] = {"material": material, "source": source}
     aor = bulk[bulk["test"] == "angle_of_repose"]
-    if len(aor) and np.isfinite(aor["aor"].iloc[0]):
-        value = float(aor["aor"].iloc[0])
-        record["angle_of_repose"] = {"value": round(noisy(value), 4), "sd": round(noise * value, 4)}
-    conditions = []
+    if len(aor) and aor["aor"].notna().any():
+        value, sd = measured(aor["aor"], "aor")
+        record["angle_of_repose"] = {"value": round(value, 4), "sd": round(sd, 4)}
     shear = bulk[bulk["test"] == "shear_cell"]
     if p_values is not None:
-        shear = shear[shear["P"].round(6).isin([round(p, 6) for p in p_values])]
-    for _, row in shear.sort_values(["normal_stress", "P"]).iterrows():
-        entry: dict[str, float] = {
-            "normal_stress": float(row["normal_stress"]),
-            "P": float(row["P"]),
-        }
+        shear = shear[shear["P"].round(6).isin([round(float(p), 6) for p in p_values])]
+    conditions = []
+    # Runs without a value (a phase that lost its load, no plateau) are left out of the mean,
+    # as a laboratory discards a failed test, and the source says where.
+    short = []
+    for (stress, p), rows in shear.groupby(["normal_stress", "P"], sort=True):
+        entry: dict[str, float] = {"normal_stress": float(stress), "P": float(p)}
         for name in observables:
-            if np.isfinite(row[name]):
-                entry[name] = round(noisy(float(row[name])), 6)
-                entry[f"{name}_sd"] = round(noise * float(row[name]), 6)
+            valid = int(rows[name].notna().sum())
+            if valid < len(rows):
+                short.append(f"{name} at {stress:g} Pa, P {p:g}: {valid} of {len(rows)}")
+            if valid:
+                value, sd = measured(rows[name], name)
+                entry[name] = round(value, 6)
+                entry[f"{name}_sd"] = round(sd, 6)
         conditions.append(entry)
     if conditions:
         record["shear_cell"] = conditions
+    if short:
+        record["source"] = f"{source}; runs with a value: {'; '.join(short)}"
     return record
 
 
@@ -177,9 +237,12 @@ def write_synthetic_experiment(
     p_values: Sequence[float] | None = None,
     truth_engine: str | None = None,
     normal_stresses: Sequence[float] | None = None,
+    replicates: int = 1,
+    work_dir: str | Path | None = None,
+    workers: int = 1,
 ) -> Path:
     """Run the virtual tests at the true parameters of a truth file and write an experiment
-    file.
+    file: the mean of ``replicates`` runs per value, with relative Gaussian ``noise`` added.
 
     Parameters
     ----------
@@ -189,8 +252,12 @@ def write_synthetic_experiment(
         File with ``material`` and the true ``parameters``; it is not copied into the output.
     out_path : path
         Experiment file to write.
-    noise, seed, observables, p_values
-        As in :func:`experiment_record`.
+    noise : float
+        Relative standard deviation of the noise added to every value (e.g. 0.01).
+    seed : int
+        Seed of the noise.
+    observables, p_values
+        As in :func:`replicate_record`.
     truth_engine : str, optional
         Command template of the truth runs (e.g. ``liggghts -in {deck}``), so that the
         measurements come from another code than the model under calibration; default the
@@ -198,6 +265,13 @@ def write_synthetic_experiment(
     normal_stresses : sequence of float, optional
         Normal stresses (Pa) of the shear-cell truth runs, instead of the configuration's
         ``shear_cell.normal_stresses`` (one run per stress, so fewer stresses cost fewer runs).
+    replicates : int
+        Truth runs per test, each from a fresh packing (:func:`simulate_reference`).
+    work_dir : path, optional
+        Where the truth runs are kept, so that an interrupted set resumes; a temporary
+        directory when None.
+    workers : int
+        Truth runs at the same time.
 
     Returns
     -------
@@ -211,14 +285,17 @@ def write_synthetic_experiment(
     engine = str(config["engine"]["command"])
     truth = yaml.safe_load(Path(truth_path).read_text())
     with tempfile.TemporaryDirectory() as tmp:
-        bulk = simulate_reference(truth["parameters"], config, tmp)
-    record = experiment_record(
+        bulk = simulate_reference(
+            truth["parameters"], config, work_dir or tmp, replicates=replicates, workers=workers
+        )
+    runs = f"mean of {replicates} runs" if replicates > 1 else "one run"
+    record = replicate_record(
         bulk,
         f"{truth['material']} ({config['profile']} profile)",
-        noise,
+        {name: noise for name in (*observables, "aor")},
         seed,
         f"`{engine}` at the parameters of {Path(truth_path).name}, {config_path}{stresses}, "
-        f"noise {noise:.1%}",
+        f"{runs}, noise {noise:.1%}",
         observables=tuple(observables),
         p_values=tuple(float(p) for p in p_values) if p_values else None,
     )

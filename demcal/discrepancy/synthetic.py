@@ -17,17 +17,15 @@ cohesion, rolling resistance or size spread can each be hidden in the data.
 from __future__ import annotations
 
 import copy
-import math
 from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
 import yaml
 
-from demcal.bulk.synthetic import run_case_bulk
+from demcal.bulk.synthetic import replicate_record, run_case_bulk
 from demcal.core.config import validate_config
 from demcal.design.cases import shear_suffixes
 from demcal.discrepancy.candidates import deep_merge
@@ -39,7 +37,6 @@ __all__ = [
     "NOISE",
     "hidden_effect_bulk",
     "prepare_study",
-    "replicate_record",
     "study_config",
     "study_overrides",
     "write_hidden_effect_experiment",
@@ -265,74 +262,6 @@ def hidden_effect_bulk(
     with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
         frames = list(pool.map(run, cases))
     return pd.concat(frames, ignore_index=True)
-
-
-def replicate_record(
-    bulk: pd.DataFrame,
-    material: str,
-    noise: Mapping[str, float],
-    seed: int,
-    source: str,
-    observables: Sequence[str] = ("mu_psh", "mu_sh", "rho_b"),
-    p_values: Sequence[float] | None = None,
-) -> dict[str, Any]:
-    """An experiment-file mapping: the mean of the replicates with its standard deviation.
-
-    Every value is the mean over the n replicate runs times (1 + noise_k * N(0, 1)); its sd is
-    sqrt(s^2 / n + (noise_k * mean)^2) with s the sample standard deviation of the replicates (0
-    for a single run): the standard error of the mean combined with the added noise, the
-    uncertainty of the value that is stated.
-
-    Parameters
-    ----------
-    bulk : DataFrame
-        Output of :func:`hidden_effect_bulk`.
-    noise : mapping
-        Relative standard deviation of the added noise per observable (``mu_psh``, ``mu_sh``,
-        ``rho_b``, ``aor``; a missing one gets none).
-    observables : sequence of str
-        Shear-cell readings to keep (partial data, as a real test may give).
-    p_values : sequence of float, optional
-        Shear load fractions to keep; all when None.
-    """
-    rng = np.random.default_rng(seed)
-
-    def measured(values: pd.Series, name: str) -> tuple[float, float]:
-        vals = values.dropna().to_numpy(float)
-        mean = float(vals.mean())
-        scatter = float(vals.std(ddof=1) / math.sqrt(vals.size)) if vals.size > 1 else 0.0
-        level = float(noise.get(name, 0.0))
-        value = mean * (1.0 + level * rng.standard_normal()) if level > 0 else mean
-        return value, math.hypot(scatter, level * mean)
-
-    record: dict[str, Any] = {"material": material, "source": source}
-    aor = bulk[bulk["test"] == "angle_of_repose"]
-    if len(aor) and aor["aor"].notna().any():
-        value, sd = measured(aor["aor"], "aor")
-        record["angle_of_repose"] = {"value": round(value, 4), "sd": round(sd, 4)}
-    shear = bulk[bulk["test"] == "shear_cell"]
-    if p_values is not None:
-        shear = shear[shear["P"].round(6).isin([round(float(p), 6) for p in p_values])]
-    conditions = []
-    # Runs without a value (a phase that lost its load, no plateau) are left out of the mean,
-    # as a laboratory discards a failed test, and the source says where.
-    short = []
-    for (stress, p), rows in shear.groupby(["normal_stress", "P"], sort=True):
-        entry: dict[str, float] = {"normal_stress": float(stress), "P": float(p)}
-        for name in observables:
-            valid = int(rows[name].notna().sum())
-            if valid < len(rows):
-                short.append(f"{name} at {stress:g} Pa, P {p:g}: {valid} of {len(rows)}")
-            if valid:
-                value, sd = measured(rows[name], name)
-                entry[name] = round(value, 6)
-                entry[f"{name}_sd"] = round(sd, 6)
-        conditions.append(entry)
-    if conditions:
-        record["shear_cell"] = conditions
-    if short:
-        record["source"] = f"{source}; runs with a value: {'; '.join(short)}"
-    return record
 
 
 def write_hidden_effect_experiment(

@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 from matplotlib.container import BarContainer
 
+from demcal.bulk.synthetic import replicate_record
 from demcal.discrepancy.candidates import Candidate
 from demcal.discrepancy.extension import (
     extended_training_data,
@@ -16,7 +17,6 @@ from demcal.discrepancy.extension import (
 )
 from demcal.discrepancy.report import gap_figure, gap_of, gap_table, markdown_table
 from demcal.discrepancy.run_results import read_runs, replicate_statistics, run_values
-from demcal.discrepancy.synthetic import replicate_record
 from demcal.surrogates.training import load_surrogate
 from tests.figures import read_png, saved_figures
 

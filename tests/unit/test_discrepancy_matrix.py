@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 import yaml
 
+from demcal.bulk.synthetic import replicate_record
 from demcal.discrepancy.effect_verdict import (
     CONFIRMED,
     GAP_REMAINS,
@@ -16,7 +17,6 @@ from demcal.discrepancy.effect_verdict import (
     dem_noise_bound,
     effect_verdict,
 )
-from demcal.discrepancy.synthetic import replicate_record
 from demcal.discrepancy.validation_matrix import (
     AMBIGUOUS,
     GAP_COLUMNS,
