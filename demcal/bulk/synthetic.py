@@ -70,7 +70,9 @@ def simulate_reference(
     def run(item: tuple[str, dict, int]) -> pd.DataFrame:
         test, case, r = item
         run_config = {**config, "seed": int(config["seed"]) + r}
-        rows = run_case_bulk(test, case, run_config, work_dir / test / case["case_id"], "run")
+        rows = run_case_bulk(
+            test, case, run_config, work_dir / test / case["case_id"], "reference run"
+        )
         rows["replicate"] = r
         return rows
 
