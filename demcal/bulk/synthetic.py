@@ -9,7 +9,7 @@ scatters by 3-4 % in the friction values, as much as the acceptance tolerance.
 import json
 import math
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -23,6 +23,60 @@ from demcal.core.config import load_config
 from demcal.design.cases import load_condition, shear_suffixes
 from demcal.engine_io.run import engine_command, run_deck
 from demcal.virtual_tests.deck import render_case
+
+Case = tuple[str, dict[str, Any]]
+"""A virtual test's name and its case row (``case_id``, parameters, load)."""
+
+
+def run_replicates(
+    cases_of: Callable[[int], Sequence[Case]],
+    config: Mapping[str, Any],
+    work_dir: str | Path,
+    label: str,
+    replicates: int = 1,
+    workers: int = 1,
+) -> pd.DataFrame:
+    """Run the cases of every replicate, the r-th (from 0) with the configuration seed + r.
+
+    Parameters
+    ----------
+    cases_of : callable
+        Replicate number -> its cases; their ``case_id`` must differ between replicates.
+    config : mapping
+        Validated configuration the tests run with.
+    work_dir : path
+        Where the runs are made (``<work_dir>/<test>/<case_id>``); runs that finished there
+        earlier are read back.
+    label : str
+        What a failed run is called in the error, e.g. ``"reference run"``.
+    replicates : int
+        Repetitions of every case, each from a fresh packing; column ``replicate`` numbers
+        them.
+    workers : int
+        Runs at the same time.
+
+    Returns
+    -------
+    DataFrame
+        Tidy bulk-value rows with ``test`` and ``replicate`` columns.
+
+    Raises
+    ------
+    RuntimeError
+        When a run fails (names its directory).
+    """
+    items = [(test, case, r) for r in range(int(replicates)) for test, case in cases_of(r)]
+
+    def run(item: tuple[str, dict[str, Any], int]) -> pd.DataFrame:
+        test, case, r = item
+        run_config = {**config, "seed": int(config["seed"]) + r}
+        rows = run_case_bulk(test, case, run_config, Path(work_dir) / test / case["case_id"], label)
+        rows["replicate"] = r
+        return rows
+
+    with ThreadPoolExecutor(max_workers=max(1, int(workers))) as pool:
+        frames = list(pool.map(run, items))
+    return pd.concat(frames, ignore_index=True)
 
 
 def simulate_reference(
@@ -58,27 +112,15 @@ def simulate_reference(
     RuntimeError
         When a run fails (names its directory).
     """
-    work_dir = Path(work_dir)
-    cases: list[tuple[str, dict, int]] = []
-    for r in range(int(replicates)):
-        cases.append(("angle_of_repose", {"case_id": f"reference{r}", **parameters}, r))
+
+    def cases_of(r: int) -> list[Case]:
+        cases: list[Case] = [("angle_of_repose", {"case_id": f"reference{r}", **parameters})]
         for suffix in shear_suffixes(config):
-            key = f"reference{r}{suffix}"
             load = load_condition(config, f"reference{suffix}")
-            cases.append(("shear_cell", {"case_id": key, **parameters, **load}, r))
+            cases.append(("shear_cell", {"case_id": f"reference{r}{suffix}", **parameters, **load}))
+        return cases
 
-    def run(item: tuple[str, dict, int]) -> pd.DataFrame:
-        test, case, r = item
-        run_config = {**config, "seed": int(config["seed"]) + r}
-        rows = run_case_bulk(
-            test, case, run_config, work_dir / test / case["case_id"], "reference run"
-        )
-        rows["replicate"] = r
-        return rows
-
-    with ThreadPoolExecutor(max_workers=max(1, int(workers))) as pool:
-        frames = list(pool.map(run, cases))
-    return pd.concat(frames, ignore_index=True)
+    return run_replicates(cases_of, config, work_dir, "reference run", replicates, workers)
 
 
 def finished_run(case_dir: Path) -> tuple[list[str], str, str] | None:

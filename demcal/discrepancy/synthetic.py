@@ -18,14 +18,13 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Mapping, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 import yaml
 
-from demcal.bulk.synthetic import replicate_record, run_case_bulk
+from demcal.bulk.synthetic import Case, replicate_record, run_replicates
 from demcal.core.config import validate_config
 from demcal.design.cases import shear_suffixes
 from demcal.discrepancy.candidates import deep_merge
@@ -241,27 +240,18 @@ def hidden_effect_bulk(
     if engine_command is not None:
         cfg = deep_merge(cfg, {"engine": {"command": engine_command}})
     params = dict(truth.parameters)
-    cases: list[tuple[str, dict[str, Any], int]] = []
-    for r in range(replicates):
+
+    def cases_of(r: int) -> list[Case]:
+        cases: list[Case] = []
         if "angle_of_repose" in tests:
-            cases.append(("angle_of_repose", {"case_id": f"truth{r}", **params}, r))
+            cases.append(("angle_of_repose", {"case_id": f"truth{r}", **params}))
         if "shear_cell" in tests:
             for suffix in shear_suffixes(cfg) + held_out_suffixes(cfg):
                 key = f"truth{r}{suffix}"
-                row = {"case_id": key, **params, **run_load(cfg, key)}
-                cases.append(("shear_cell", row, r))
+                cases.append(("shear_cell", {"case_id": key, **params, **run_load(cfg, key)}))
+        return cases
 
-    def run(item: tuple[str, dict[str, Any], int]) -> pd.DataFrame:
-        test, case, r = item
-        run_cfg = deep_merge(cfg, {"seed": int(cfg["seed"]) + r})
-        case_dir = Path(work_dir) / test / case["case_id"]
-        rows = run_case_bulk(test, case, run_cfg, case_dir, "truth run")
-        rows["replicate"] = r
-        return rows
-
-    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-        frames = list(pool.map(run, cases))
-    return pd.concat(frames, ignore_index=True)
+    return run_replicates(cases_of, cfg, work_dir, "truth run", replicates, workers)
 
 
 def write_hidden_effect_experiment(

@@ -5,7 +5,12 @@ within a relative tolerance of the measurements at a load condition (eq. 3); a m
 *valid* when its predicted angle of repose also lies within the tolerance (eq. 4). Only the
 observables present in a measurement are matched, so partial data sets are allowed.
 
-:func:`within_tolerance` is the one implementation of the rule ``|1 - num/exp| < tol``. The
+A measured value is known only to within its standard deviation, so where the measurement
+states one the band is widened by ``coverage`` standard deviations, added in quadrature:
+``|num - exp| < sqrt((tol * exp)^2 + (coverage * sd)^2)`` (:func:`acceptance_band`). Without a
+standard deviation, or with ``coverage`` 0, this is the paper's rule ``|1 - num/exp| < tol``.
+
+:func:`within_tolerance` is the one implementation of the rule. The
 screening (:func:`demcal.identification.screening.screen`) applies it stage by stage through
 :func:`sequential_filter`: eq. 3 at every shear-cell load condition, then eq. 4 on the sets that
 are left; the verification table applies it to the DEM values at the identified set.
@@ -43,12 +48,41 @@ def relative_deviation(num: np.ndarray | float, exp: np.ndarray | float) -> np.n
     return np.abs(1.0 - num_arr / exp_arr)
 
 
+def acceptance_band(
+    exp: float, tol: float, sd: float | None = None, coverage: float = 0.0
+) -> float:
+    """Relative half-width of the acceptance band around one measured value.
+
+    Parameters
+    ----------
+    exp : float
+        Measured value (any unit); non-zero.
+    tol : float
+        Relative tolerance, e.g. 0.05 for 5 %.
+    sd : float or None
+        Standard deviation of the measured value, same unit; None when not stated.
+    coverage : float
+        Standard deviations of the measurement added to the band in quadrature (2: about 95 %
+        of the values a repeated measurement would give); 0 keeps the tolerance alone.
+
+    Returns
+    -------
+    float
+        ``sqrt(tol^2 + (coverage * sd / exp)^2)``, dimensionless; ``tol`` when ``sd`` is None.
+    """
+    if sd is None or coverage == 0.0:
+        return float(tol)
+    return float(np.hypot(tol, coverage * sd / abs(exp)))
+
+
 def within_tolerance(
     pred: Mapping[str, np.ndarray],
     measured: Mapping[str, float],
     tol: float = DEFAULT_TOLERANCE,
+    uncertainties: Mapping[str, float] | None = None,
+    coverage: float = 0.0,
 ) -> np.ndarray:
-    """Sets whose predictions match every measured value within ``tol`` (strict ``<``).
+    """Sets whose predictions match every measured value within its band (strict ``<``).
 
     Parameters
     ----------
@@ -58,17 +92,24 @@ def within_tolerance(
         Measured values by output name; only these observables are matched.
     tol : float
         Relative tolerance, e.g. 0.05 for 5 %.
+    uncertainties : Mapping[str, float], optional
+        Standard deviations of (some of) the measured values, same units.
+    coverage : float
+        Standard deviations added to the band in quadrature (:func:`acceptance_band`).
 
     Returns
     -------
     numpy.ndarray of bool, shape (n,)
-        True where ``|1 - pred/measured| < tol`` for all measured observables. NaN
-        predictions are never accepted.
+        True where ``|1 - pred/measured|`` is below the band of every measured observable
+        (``tol`` where no standard deviation is given). NaN predictions are never accepted.
     """
     if not measured:
         raise ValueError("within_tolerance: no measured values to match")
     if not tol > 0.0:
         raise ValueError(f"within_tolerance: tol must be > 0, got {tol!r}")
+    if not coverage >= 0.0:
+        raise ValueError(f"within_tolerance: coverage must be >= 0, got {coverage!r}")
+    sds = uncertainties or {}
     mask: np.ndarray | None = None
     for key, exp in measured.items():
         if key not in pred:
@@ -78,7 +119,8 @@ def within_tolerance(
             raise ValueError(
                 f"within_tolerance: predictions of {key!r} must be 1-D, got shape {values.shape}"
             )
-        ok = relative_deviation(values, exp) < tol
+        band = acceptance_band(exp, tol, sds.get(key), coverage)
+        ok = relative_deviation(values, exp) < band
         if mask is None:
             mask = ok
         elif ok.shape != mask.shape:

@@ -17,7 +17,11 @@ import pandas as pd
 import torch
 
 from demcal.core.experiments import Experiment
-from demcal.identification.acceptance import relative_deviation, within_tolerance
+from demcal.identification.acceptance import (
+    acceptance_band,
+    relative_deviation,
+    within_tolerance,
+)
 from demcal.identification.candidate_grid import draw_axes
 from demcal.identification.screening import screen
 from demcal.identification.screening_stages import Stage, stage_from_condition
@@ -81,6 +85,7 @@ def predictions_at(
     predictors: Mapping[str, tuple[ConstantInputs, Sequence[str]]],
     experiment: Experiment,
     tol: float,
+    coverage: float = 0.0,
 ) -> list[dict[str, Any]]:
     """The surrogates' prediction of every measured value at one parameter set.
 
@@ -98,13 +103,17 @@ def predictions_at(
         The measurements.
     tol : float
         Relative acceptance tolerance.
+    coverage : float
+        Standard deviations of a measured value that widen its band, as in the screening
+        (:func:`demcal.identification.acceptance.acceptance_band`).
 
     Returns
     -------
     list of dict
         Per measured value with a predictor, in the experiment's order: ``observable``,
         ``normal_stress`` (Pa) and ``P`` (None for the angle of repose), ``measured``,
-        ``predicted``, ``deviation`` (|1 - predicted / measured|) and ``within_tolerance``.
+        ``predicted``, ``deviation`` (|1 - predicted / measured|), ``band`` (the relative
+        half-width it was accepted within) and ``within_tolerance``.
     """
     out: list[dict[str, Any]] = []
     for obs in measured_observations(experiment):
@@ -119,7 +128,11 @@ def predictions_at(
         inputs = {**point, **load}
         model, free = predictors[name]
         predicted = float(model.predict(np.array([[float(inputs[f]) for f in free]]))[0])
-        accepted = within_tolerance({name: np.array([predicted])}, {name: measured}, tol)
+        sd = float(obs["measured_sd"])
+        sds = {name: sd} if math.isfinite(sd) else {}
+        accepted = within_tolerance(
+            {name: np.array([predicted])}, {name: measured}, tol, sds, coverage
+        )
         out.append(
             {
                 "observable": name,
@@ -128,17 +141,24 @@ def predictions_at(
                 "measured": measured,
                 "predicted": predicted,
                 "deviation": float(relative_deviation(predicted, measured)),
+                "band": acceptance_band(measured, tol, sds.get(name), coverage),
                 "within_tolerance": bool(accepted[0]),
             }
         )
     return out
 
 
-def _aor_stage(value: float, tol: float) -> Stage:
+def _aor_stage(value: float, sd: float | None, tol: float, coverage: float) -> Stage:
     return Stage(
         name="aor",
         outputs=("aor",),
-        accept=partial(within_tolerance, measured={"aor": value}, tol=tol),
+        accept=partial(
+            within_tolerance,
+            measured={"aor": value},
+            tol=tol,
+            uncertainties={} if sd is None else {"aor": sd},
+            coverage=coverage,
+        ),
         fixed={},
     )
 
@@ -158,7 +178,8 @@ def calibrate(
     experiment : Experiment
         The measurements; only what was measured is matched.
     screening : mapping
-        The ``screening`` config section (axes, seed, chunk_size, threads, tolerance).
+        The ``screening`` config section (axes, seed, chunk_size, threads, tolerance,
+        measurement_coverage).
     constants : mapping
         Output name -> inputs held constant for that network (e.g. the test's dCylDp).
 
@@ -170,6 +191,7 @@ def calibrate(
     spec = {k: (float(v[0]), float(v[1]), int(v[2])) for k, v in screening["axes"].items()}
     axes = draw_axes(spec, int(screening["seed"]))
     tol = float(screening["tolerance"])
+    coverage = float(screening["measurement_coverage"])
     predictors = {}
     for output, (model, features) in surrogates.items():
         wrapped = ConstantInputs(model, features, constants.get(output, {}))
@@ -181,12 +203,12 @@ def calibrate(
             )
         predictors[output] = (wrapped, wrapped.free)
     shear_stages = [
-        stage_from_condition(c, tol)
+        stage_from_condition(c, tol, coverage)
         for c in experiment.shear_conditions
         if all(o in predictors for o in c.values)
     ]
     aor_stages = (
-        [_aor_stage(experiment.angle_of_repose, tol)]
+        [_aor_stage(experiment.angle_of_repose, experiment.angle_of_repose_sd, tol, coverage)]
         if experiment.angle_of_repose is not None and "aor" in predictors
         else []
     )
@@ -216,7 +238,9 @@ def calibrate(
     chosen = next((g for g in reversed(GROUPS) if g in valid and len(valid[g]) > 0), None)
     identified = identified_parameters(valid[chosen], list(axes)) if chosen else {}
     at_identified = (
-        predictions_at({k: v["mean"] for k, v in identified.items()}, predictors, experiment, tol)
+        predictions_at(
+            {k: v["mean"] for k, v in identified.items()}, predictors, experiment, tol, coverage
+        )
         if identified
         else []
     )

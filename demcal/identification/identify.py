@@ -99,7 +99,8 @@ def identify(
     experiment_file : path
         The measured bulk values (``config/experiments/*.yaml``).
     screening : mapping
-        The ``screening`` config section (axes, seed, chunk_size, threads, tolerance).
+        The ``screening`` config section (axes, seed, chunk_size, threads, tolerance,
+        measurement_coverage).
     constants : mapping
         Bulk value -> network inputs held constant (e.g. the test's dCylDp).
     config : mapping
@@ -119,6 +120,7 @@ def identify(
     choice = str(config["surrogate"]["screen_with"])
     experiment = load_experiment(experiment_file)
     tol = float(screening["tolerance"])
+    coverage = float(screening["measurement_coverage"])
     loaded = {
         name: load_screening_surrogate(path, choice, experiment, tol)
         for name, path in models.items()
@@ -131,13 +133,16 @@ def identify(
     if dataset is not None:
         reach = reach_of_measurements(pd.read_csv(dataset), experiment, tol)
     statement = reach_statement(reach, experiment.material) + "\n\n" if reach else ""
-    mean_line = mean_set_statement(result.at_identified, tol) if result.at_identified else ""
+    mean_line = (
+        mean_set_statement(result.at_identified, tol, coverage) if result.at_identified else ""
+    )
     if mean_line:
         statement += mean_line + "\n\n"
     text = statement + (
         f"# Table 5: valid parameter sets for {experiment.material}\n\n"
-        f"{result.n_total} candidate sets screened in {result.elapsed_s:.2f} s; tolerance "
-        f"{screening['tolerance']:.0%}; {screened_with_statement(methods, choice)}\n\n"
+        f"{result.n_total} candidate sets screened in {result.elapsed_s:.2f} s; accepted "
+        f"within {tolerance_text(tol, coverage)}; {screened_with_statement(methods, choice)}"
+        "\n\n"
     )
     text += table5_markdown(result.table5) if len(result.table5) else "No measurement to match.\n"
     Path(files.table5).write_text(text + "\n")
@@ -178,7 +183,26 @@ def _condition(row: Mapping[str, Any]) -> str:
     return f"{row['observable']} at {row['normal_stress']:g} Pa, P = {row['P']:g}"
 
 
-def mean_set_statement(at_mean: list[dict[str, Any]], tol: float) -> str:
+def tolerance_text(tol: float, coverage: float = 0.0) -> str:
+    """The acceptance rule in words, e.g. "the 5% tolerance" (no trailing full stop).
+
+    Parameters
+    ----------
+    tol : float
+        Relative acceptance tolerance.
+    coverage : float
+        Standard deviations of a measured value that widen its band (``screening``
+        ``measurement_coverage``).
+    """
+    if coverage == 0.0:
+        return f"the {tol:.0%} tolerance"
+    return (
+        f"the {tol:.0%} tolerance widened by {coverage:g} standard deviations of each measured "
+        "value that states one"
+    )
+
+
+def mean_set_statement(at_mean: list[dict[str, Any]], tol: float, coverage: float = 0.0) -> str:
     """One line on whether the surrogates accept the identified mean set itself.
 
     Parameters
@@ -187,17 +211,19 @@ def mean_set_statement(at_mean: list[dict[str, Any]], tol: float) -> str:
         :func:`demcal.identification.calibration.predictions_at` at the identified means.
     tol : float
         Relative acceptance tolerance.
+    coverage : float
+        Standard deviations of a measured value that widen its band.
 
     Returns
     -------
     str
         A single line (no trailing newline).
     """
+    rule = tolerance_text(tol, coverage)
     missed = [r for r in at_mean if not r["within_tolerance"]]
     if not missed:
         return (
-            f"At the identified mean set the surrogates predict every measured value within "
-            f"the {tol:.0%} tolerance."
+            f"At the identified mean set the surrogates predict every measured value within {rule}."
         )
     parts = "; ".join(
         f"{_condition(r)} {r['predicted']:.4g} against {r['measured']:.4g} "
@@ -206,7 +232,7 @@ def mean_set_statement(at_mean: list[dict[str, Any]], tol: float) -> str:
     )
     return (
         f"**The identified mean set is not itself a valid set**: there the surrogates predict "
-        f"{parts}, beyond the {tol:.0%} tolerance. The valid sets lie around it, not at it (a "
+        f"{parts}, beyond {rule}. The valid sets lie around it, not at it (a "
         "curved or thin valid region), so the verification at the mean is expected to miss "
         "by about as much: read it before using material.in."
     )

@@ -114,9 +114,9 @@ def screen(
         ``P``); stage-specific values override these.
     stages : Sequence[Stage or MeasuredCondition]
         Acceptance steps applied in order; a stage sees only the survivors of the earlier
-        ones. A :class:`~demcal.identification.acceptance.MeasuredCondition` is matched within
-        ``tol`` on its
-        measured observables at its load.
+        ones. A :class:`~demcal.core.experiments.MeasuredCondition` is matched within
+        ``tol`` on its measured observables at its load (the tolerance alone; a stage from
+        :func:`stage_from_condition` can widen it by the measurement's standard deviation).
     tol : float
         Relative tolerance used for MeasuredCondition stages.
     chunk_size : int

@@ -57,16 +57,26 @@ class Stage:
     fixed: Mapping[str, float] = field(default_factory=dict)
 
 
-def stage_from_condition(condition: MeasuredCondition, tol: float = DEFAULT_TOLERANCE) -> Stage:
-    """Stage that accepts sets within ``tol`` of every value measured at ``condition``.
+def stage_from_condition(
+    condition: MeasuredCondition, tol: float = DEFAULT_TOLERANCE, coverage: float = 0.0
+) -> Stage:
+    """Stage that accepts sets within the band of every value measured at ``condition``.
 
-    The outputs evaluated are the measured observables (predictor names must equal the output
-    names) and the condition's load (``normal_stress``, ``P``) is held fixed.
+    The band is ``tol`` widened by ``coverage`` standard deviations of each measured value that
+    states one (:func:`demcal.identification.acceptance.acceptance_band`). The outputs evaluated
+    are the measured observables (predictor names must equal the output names) and the
+    condition's load (``normal_stress``, ``P``) is held fixed.
     """
     return Stage(
         name=condition.label,
         outputs=tuple(condition.values),
-        accept=partial(within_tolerance, measured=dict(condition.values), tol=tol),
+        accept=partial(
+            within_tolerance,
+            measured=dict(condition.values),
+            tol=tol,
+            uncertainties=dict(condition.uncertainties),
+            coverage=coverage,
+        ),
         fixed=condition.load,
     )
 

@@ -7,11 +7,13 @@ import pytest
 
 from demcal.core.experiments import MeasuredCondition
 from demcal.identification.acceptance import (
+    acceptance_band,
     relative_deviation,
     sequential_filter,
     within_tolerance,
 )
 from demcal.identification.screening import screen
+from demcal.identification.screening_stages import stage_from_condition
 
 
 def test_relative_deviation_values() -> None:
@@ -54,6 +56,40 @@ def test_within_tolerance_partial_data_ignores_unmeasured_outputs() -> None:
 def test_within_tolerance_nan_never_accepted() -> None:
     mask = within_tolerance({"aor": np.array([np.nan, 38.85])}, {"aor": 38.85})
     np.testing.assert_array_equal(mask, [False, True])
+
+
+def test_band_widened_by_measurement_sd_in_quadrature() -> None:
+    # mu_sh 0.60 +- 0.015 (2.5 %): with two standard deviations the band is
+    # sqrt(5 %^2 + 5 %^2) = 7.07 %, i.e. +-0.0424 around 0.60.
+    assert acceptance_band(0.60, 0.05, 0.015, 2.0) == pytest.approx(0.05 * np.sqrt(2.0))
+    assert acceptance_band(0.60, 0.05, None, 2.0) == 0.05
+    assert acceptance_band(0.60, 0.05, 0.015, 0.0) == 0.05
+    pred = {"mu_sh": np.array([0.60 + 0.0420, 0.60 + 0.0428, 0.60 - 0.0420, 0.60 + 0.031])}
+    measured = {"mu_sh": 0.60}
+    widened = within_tolerance(pred, measured, 0.05, {"mu_sh": 0.015}, coverage=2.0)
+    np.testing.assert_array_equal(widened, [True, False, True, True])
+    # The paper's rule: without coverage, or without an sd, only the 5 % band (+-0.030).
+    paper = [False, False, False, False]
+    np.testing.assert_array_equal(within_tolerance(pred, measured, 0.05), paper)
+    np.testing.assert_array_equal(within_tolerance(pred, measured, 0.05, {}, 2.0), paper)
+    np.testing.assert_array_equal(
+        within_tolerance(pred, measured, 0.05, {"mu_sh": 0.015}, coverage=0.0), paper
+    )
+    with pytest.raises(ValueError, match="coverage"):
+        within_tolerance(pred, measured, 0.05, {"mu_sh": 0.015}, coverage=-1.0)
+
+
+def test_condition_stage_uses_each_values_own_sd() -> None:
+    # rho_b states an sd of 42 kg/m^3 (band sqrt(88^2 + 84^2) = 121.7 kg/m^3), mu_psh none.
+    cond = MeasuredCondition(
+        {"mu_psh": 0.6, "rho_b": 1760.0}, {"rho_b": 42.0}, normal_stress=10070.0, P=1.0
+    )
+    stage = stage_from_condition(cond, 0.05, coverage=2.0)
+    pred = {
+        "mu_psh": np.array([0.6, 0.6, 0.6 * 1.049, 0.6 * 1.051]),
+        "rho_b": np.array([1760.0 + 121.0, 1760.0 + 122.5, 1760.0, 1760.0]),
+    }
+    np.testing.assert_array_equal(stage.accept(pred), [True, False, True, False])
 
 
 def test_within_tolerance_errors() -> None:

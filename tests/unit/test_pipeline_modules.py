@@ -310,7 +310,14 @@ def test_load_experiment_partial_and_invalid(tmp_path):
 
 def screening_section(axes: dict) -> dict:
     """A screening config section over ``axes`` (name -> [low, high, count]), 5 % tolerance."""
-    return {"axes": axes, "seed": 1, "tolerance": 0.05, "chunk_size": 1024, "threads": 1}
+    return {
+        "axes": axes,
+        "seed": 1,
+        "tolerance": 0.05,
+        "measurement_coverage": 2.0,
+        "chunk_size": 1024,
+        "threads": 1,
+    }
 
 
 class Linear:
@@ -433,6 +440,33 @@ def test_a_mean_outside_a_curved_valid_region_is_named(tmp_path):
     assert mean_set_statement([{**row, "within_tolerance": True}], 0.05).startswith(
         "At the identified mean set the surrogates predict every measured value within the 5%"
     )
+
+
+def test_measured_sd_widens_the_screening_band():
+    # Angle 40 +- 1.5 deg: the 5 % band is +-2 deg; two standard deviations in quadrature make
+    # it +-sqrt(2^2 + 3^2) = +-3.61 deg, and only a measurement with an sd is widened.
+    features = ["coefficientFriction", "coefficientRollingFriction"]
+    axes = {"coefficientFriction": [0.1, 1.0, 91], "coefficientRollingFriction": [0.1, 1.0, 91]}
+    bowl = {"aor": (Bowl(30.0, 10.0 / 0.09), features)}
+    with_sd = Experiment("m", "", [], angle_of_repose=40.0, angle_of_repose_sd=1.5)
+    counts = {}
+    for coverage in (0.0, 2.0):
+        screening = {**screening_section(axes), "measurement_coverage": coverage}
+        result = calibrate(bowl, with_sd, screening, {})
+        frame = result.valid["AoR"]
+        mu_s = frame["coefficientFriction"].to_numpy()
+        mu_r = frame["coefficientRollingFriction"].to_numpy()
+        angle = 30.0 + 10.0 / 0.09 * ((mu_s - 0.55) ** 2 + (mu_r - 0.55) ** 2)
+        band = 2.0 if coverage == 0.0 else float(np.hypot(2.0, 3.0))
+        assert np.all(np.abs(angle - 40.0) < band + 1e-3)
+        assert np.abs(angle - 40.0).max() > band - 0.3
+        (row,) = result.at_identified
+        assert row["band"] == pytest.approx(band / 40.0)
+        counts[coverage] = len(frame)
+    assert counts[2.0] > 1.5 * counts[0.0] > 0
+    without_sd = Experiment("m", "", [], angle_of_repose=40.0)
+    result = calibrate(bowl, without_sd, screening_section(axes), {})
+    assert len(result.valid["AoR"]) == counts[0.0]
 
 
 def test_valid_sets_written_read_back_to_six_digits(tmp_path):
