@@ -86,31 +86,14 @@ def simulate_reference(
     replicates: int = 1,
     workers: int = 1,
 ) -> pd.DataFrame:
-    """Bulk values of both virtual tests at ``parameters``.
+    """Bulk values of both virtual tests at ``parameters`` (:func:`run_replicates`).
 
     Parameters
     ----------
     parameters : mapping
         Contact parameters (SI units) by name.
-    config : mapping
-        Validated configuration the tests run with.
-    work_dir : path
-        Where the runs are made; runs that finished there earlier are read back.
-    replicates : int
-        Repetitions of every run, the r-th (from 0) with the configuration seed + r (a fresh
-        packing); column ``replicate`` numbers them.
-    workers : int
-        Runs at the same time.
-
-    Returns
-    -------
-    DataFrame
-        Tidy bulk-value rows with ``test`` and ``replicate`` columns.
-
-    Raises
-    ------
-    RuntimeError
-        When a run fails (names its directory).
+    config, work_dir, replicates, workers
+        As for :func:`run_replicates`; the cases are named ``reference<r><suffix>``.
     """
 
     def cases_of(r: int) -> list[Case]:
