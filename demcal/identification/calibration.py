@@ -8,7 +8,6 @@ import gzip
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -16,7 +15,7 @@ import numpy as np
 import pandas as pd
 import torch
 
-from demcal.core.experiments import Experiment
+from demcal.core.experiments import Experiment, MeasuredCondition
 from demcal.identification.acceptance import (
     acceptance_band,
     relative_deviation,
@@ -24,7 +23,7 @@ from demcal.identification.acceptance import (
 )
 from demcal.identification.candidate_grid import draw_axes
 from demcal.identification.screening import screen
-from demcal.identification.screening_stages import Stage, stage_from_condition
+from demcal.identification.screening_stages import stage_from_condition
 from demcal.identification.statistics import (
     combine_statistics,
     identified_parameters,
@@ -148,18 +147,13 @@ def predictions_at(
     return out
 
 
-def _aor_stage(value: float, sd: float | None, tol: float, coverage: float) -> Stage:
-    return Stage(
+def angle_condition(experiment: Experiment) -> MeasuredCondition:
+    """The measured angle of repose as a condition without load, named ``aor`` (eq. 4)."""
+    sd = experiment.angle_of_repose_sd
+    return MeasuredCondition(
+        {"aor": float(experiment.angle_of_repose)},
+        {} if sd is None else {"aor": float(sd)},
         name="aor",
-        outputs=("aor",),
-        accept=partial(
-            within_tolerance,
-            measured={"aor": value},
-            tol=tol,
-            uncertainties={} if sd is None else {"aor": sd},
-            coverage=coverage,
-        ),
-        fixed={},
     )
 
 
@@ -208,7 +202,7 @@ def calibrate(
         if all(o in predictors for o in c.values)
     ]
     aor_stages = (
-        [_aor_stage(experiment.angle_of_repose, experiment.angle_of_repose_sd, tol, coverage)]
+        [stage_from_condition(angle_condition(experiment), tol, coverage)]
         if experiment.angle_of_repose is not None and "aor" in predictors
         else []
     )
