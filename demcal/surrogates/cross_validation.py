@@ -12,8 +12,11 @@ parameter set, and scores the pooled out-of-fold predictions:
 3. the network of the hidden size selected for the saved model is trained on that part with the
    same function and settings as the saved model
    (:func:`demcal.surrogates.hidden_size_sweep.sweep_hidden_sizes` with one size), the baselines
-   are fitted on the training rows (:func:`demcal.surrogates.baselines.baseline_predictions`),
-   and all three predict the fold;
+   are fitted on every row outside the fold
+   (:func:`demcal.surrogates.baselines.baseline_predictions`), and all three predict the fold.
+   The baselines stop on no generalisation set, and the Gaussian process that may screen is
+   fitted on every usable row, so holding sets back from them would score a model fitted on a
+   sixth fewer sets than the one that screens;
 4. R^2, RMSE, MAE and MSE are computed once over the pooled predictions of all rows; the
    per-fold values give their spread (the R^2 of a fold against the variance of all rows, see
    ``CrossValidation.folds``).
@@ -235,7 +238,8 @@ def cross_validate(
         restarts.
     split : sequence of 3 floats, default (0.7, 0.15, 0.15)
         ``surrogate.split``; the training part of a fold gives up the share
-        ``split[1] / (split[0] + split[1])`` of its sets (at least one) to the generalisation set.
+        ``split[1] / (split[0] + split[1])`` of its sets (at least one) to the network's
+        generalisation set. The baselines are fitted on training and generalisation sets.
     methods : sequence of str, default METHODS
         Methods to run, a subset of ``("Bayesian", "Gaussian", "ANN")``, in output order.
     log_inputs : sequence of int, default ()
@@ -287,8 +291,9 @@ def cross_validate(
         fold_pred: dict[str, np.ndarray] = {}
         baselines = [m for m in methods if m in BASELINES]
         if baselines:
+            # No early stopping: the baselines learn from every set outside the fold.
             fitted = baseline_predictions(
-                X_arr[train], y_arr[train], X_arr[test], seed, log_inputs=log_inputs
+                X_arr[rest], y_arr[rest], X_arr[test], seed, log_inputs=log_inputs
             )
             fold_pred.update({m: fitted[m] for m in baselines})
         if "ANN" in methods:

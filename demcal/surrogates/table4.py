@@ -291,8 +291,10 @@ def section_markdown(name: str, table: pd.DataFrame, sweep: pd.DataFrame | None 
         text.append(
             f"Cross-validation: {int(first['cv_folds'])} folds by parameter set over "
             f"{int(first['cv_sets'])} sets / {int(first['cv_rows'])} rows; every row is "
-            "predicted once by models trained without its parameter set, R^2 and RMSE are "
-            "those of the pooled predictions, with their range over the folds beside them."
+            "predicted once by models trained without its parameter set (the baselines on "
+            "every row of the other folds, the network on them less its generalisation sets), "
+            "R^2 and RMSE are those of the pooled predictions, with their range over the folds "
+            "beside them."
         )
     else:
         text.append("Cross-validation: off.")
