@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
+from scipy.stats import norm
 from scipy.stats import t as student_t
 
 from demcal.core.experiments import load_experiment
@@ -129,14 +130,51 @@ def mean_interval(values_mean: float, sd: float, runs: int) -> tuple[float, floa
     return values_mean - half, values_mean + half
 
 
-def undecided(row: Mapping[str, Any], engine: str, tolerance: float) -> str | None:
-    """The row's mean interval when it straddles an edge of the tolerance band, as text.
+def verdict_interval(row: Mapping[str, Any], engine: str) -> tuple[float, float] | None:
+    """Interval of the true value of the runs' mean minus the measurement, put back on the
+    scale of the runs' mean.
+
+    The Student-t interval of the runs' mean (:func:`mean_interval`) is widened in quadrature by
+    the measured value's own uncertainty, ``z * measured_sd`` with z the normal quantile of
+    :data:`CONFIDENCE`: a measurement is a mean of a few tests, known to its stated sd (the
+    screening's acceptance band treats it alike), so a DEM mean closer to it than that cannot
+    be called a miss, however many runs it averages.
 
     Parameters
     ----------
     row : mapping
-        One row of a verification table (``measured``, ``dem_<engine>``, ``dem_sd_<engine>``,
-        ``runs_<engine>``).
+        One row of a verification table (``measured``, ``measured_sd``, ``dem_<engine>``,
+        ``dem_sd_<engine>``, ``runs_<engine>``).
+    engine : str
+        The engine whose columns are read.
+
+    Returns
+    -------
+    tuple of float or None
+        (low, high), unit of the value; the runs' interval alone where the measurement states
+        no sd; None for fewer than two runs.
+    """
+    dem, _, _ = engine_columns(engine)
+    sd, runs = scatter_columns(engine)
+    mean = float(row[dem])
+    interval = mean_interval(mean, float(row[sd]), int(row[runs]))
+    measured_sd = float(row.get("measured_sd", math.nan))
+    if interval is None or not (math.isfinite(measured_sd) and measured_sd > 0.0):
+        return interval
+    z = float(norm.ppf(0.5 + 0.5 * CONFIDENCE))
+    half = math.hypot(0.5 * (interval[1] - interval[0]), z * measured_sd)
+    return mean - half, mean + half
+
+
+def undecided(row: Mapping[str, Any], engine: str, tolerance: float) -> str | None:
+    """The row's interval (:func:`verdict_interval`) when it straddles an edge of the tolerance
+    band, as text.
+
+    Parameters
+    ----------
+    row : mapping
+        One row of a verification table (``measured``, ``measured_sd``, ``dem_<engine>``,
+        ``dem_sd_<engine>``, ``runs_<engine>``).
     engine : str
         The engine whose columns are read.
     tolerance : float
@@ -149,17 +187,23 @@ def undecided(row: Mapping[str, Any], engine: str, tolerance: float) -> str | No
         interval lies wholly inside or wholly outside the band, or for fewer than two runs.
     """
     dem, _, _ = engine_columns(engine)
-    sd, runs = scatter_columns(engine)
-    interval = mean_interval(float(row[dem]), float(row[sd]), int(row[runs]))
+    _, runs = scatter_columns(engine)
+    interval = verdict_interval(row, engine)
     measured = float(row["measured"])
     band = sorted((measured * (1.0 - tolerance), measured * (1.0 + tolerance)))
     if interval is None or interval[1] < band[0] or interval[0] > band[1]:
         return None  # one run or no value, or the interval wholly outside the band
     if band[0] <= interval[0] and interval[1] <= band[1]:
         return None  # wholly inside
+    measured_sd = float(row.get("measured_sd", math.nan))
+    widened = (
+        f", with the measured sd {measured_sd:.3g}:"
+        if math.isfinite(measured_sd) and measured_sd > 0.0
+        else ""
+    )
     return (
         f"{_condition(row)} {float(row[dem]):.4g} ({CONFIDENCE:.0%} interval of the mean of "
-        f"{int(row[runs])} runs {interval[0]:.4g}-{interval[1]:.4g}, tolerance band "
+        f"{int(row[runs])} runs{widened} {interval[0]:.4g}-{interval[1]:.4g}, tolerance band "
         f"{band[0]:.4g}-{band[1]:.4g})"
     )
 
@@ -168,8 +212,10 @@ def dem_verdict(table: pd.DataFrame, engine: str, tolerance: float) -> str:
     """One line: whether one engine's verification runs reproduce every measured value.
 
     A value whose replicate runs' mean lies on one side of an edge of the tolerance band while
-    the :data:`CONFIDENCE` interval of that mean crosses it is named as undecided: more runs
-    (``verification.seeds``, ``verification.repose_seeds``) would decide it.
+    the :data:`CONFIDENCE` interval of that mean, widened by the measured value's own sd
+    (:func:`verdict_interval`), crosses it is named as undecided: more runs
+    (``verification.seeds``, ``verification.repose_seeds``) or a more precise measurement
+    would decide it.
 
     Parameters
     ----------
@@ -206,9 +252,8 @@ def dem_verdict(table: pd.DataFrame, engine: str, tolerance: float) -> str:
         )
     unsure = [u for _, row in table.iterrows() if (u := undecided(row, engine, tolerance))]
     tail = (
-        f" Undecided at {CONFIDENCE:.0%} confidence, more replicate runs would tell: "
-        + "; ".join(unsure)
-        + "."
+        f" Undecided at {CONFIDENCE:.0%} confidence, more replicate runs (or, where the "
+        "measured sd dominates, a more precise measurement) would tell: " + "; ".join(unsure) + "."
         if unsure
         else ""
     )

@@ -42,6 +42,8 @@ from demcal.identification.verification import verification_table
 from demcal.identification.verification_run import (
     dem_verdict,
     mean_interval,
+    undecided,
+    verdict_interval,
     write_verification_table,
 )
 from tests.engine.conftest import engine_path
@@ -719,8 +721,17 @@ def test_mean_interval_is_the_student_t_interval():
         (np.array([36.9]), "**The DEM runs on configured miss 1 of the 2", False),
     ],
 )
-def test_the_verdict_names_values_whose_interval_crosses_the_tolerance(heaps, start, undecided):
-    experiment = ROOT_DIR / "config" / "experiments" / "sinter_fines.yaml"
+def test_the_verdict_names_values_whose_interval_crosses_the_tolerance(
+    heaps, start, undecided, tmp_path
+):
+    # The sinter fines' values without the bulk density's sd (its effect is tested below).
+    experiment = tmp_path / "sinter_fines_no_sd.yaml"
+    experiment.write_text(
+        (ROOT_DIR / "config" / "experiments" / "sinter_fines.yaml")
+        .read_text()
+        .replace("    rho_b_sd: 42\n", "")
+    )
+    assert "rho_b_sd" not in experiment.read_text()
     rows = [
         {"test": "shear_cell", "normal_stress": 10070.0, "P": 1.0, "rho_b": r}
         for r in (1707.0, 1717.0, 1727.0)
@@ -737,6 +748,40 @@ def test_the_verdict_names_values_whose_interval_crosses_the_tolerance(heaps, st
     if undecided:
         assert f"aor {heaps.mean():.4g} (95% interval of the mean of {heaps.size} runs" in verdict
         assert "tolerance band 36.91-40.79)" in verdict
+
+
+def test_the_measured_sd_widens_the_verdict_interval():
+    # The synthetic reference's mu_sh at 2 029 Pa, P 0.6 (LIGGGHTS, mean of 4 runs 0.5888 with
+    # its standard error and 1 % noise, sd 0.0174) against six engine runs at the identified
+    # set, 0.6436 +- 0.0235: 9.3 % high. The runs' interval alone, 0.619-0.668, lies wholly
+    # above the band 0.559-0.618 (a decided miss); widened by 1.96 x 0.0174 in quadrature it is
+    # 0.603-0.684 and crosses the band's edge: the measurement itself leaves it open.
+    row = {
+        "observable": "mu_sh",
+        "normal_stress": 2029.0,
+        "P": 0.6,
+        "measured": 0.5888,
+        "measured_sd": 0.0174,
+        "dem_configured": 0.6436,
+        "dem_sd_configured": 0.0235,
+        "runs_configured": 6,
+    }
+    runs_only = mean_interval(0.6436, 0.0235, 6)
+    assert runs_only == pytest.approx((0.6189, 0.6683), abs=2e-4)
+    assert verdict_interval({**row, "measured_sd": math.nan}, "configured") == runs_only
+    low, high = verdict_interval(row, "configured")
+    half = math.hypot(0.5 * (runs_only[1] - runs_only[0]), 1.959964 * 0.0174)
+    assert (low, high) == pytest.approx((0.6436 - half, 0.6436 + half), abs=1e-6)
+    assert undecided({**row, "measured_sd": math.nan}, "configured", 0.05) is None
+    text = undecided(row, "configured", 0.05)
+    assert text is not None and "with the measured sd 0.0174" in text
+    assert f"{low:.4g}-{high:.4g}, tolerance band 0.5594-0.6182)" in text
+    # The sinter fines' bulk density (1 760 +- 42 kg/m^3) against three runs at 1 760 +- 10:
+    # inside the band even with the measurement's sd (half-width 86 of the band's 88).
+    sinter = row | {"measured": 1760.0, "measured_sd": 42.0, "dem_configured": 1760.0}
+    sinter |= {"dem_sd_configured": 10.0, "runs_configured": 3}
+    assert undecided(sinter, "configured", 0.05) is None
+    assert undecided(sinter | {"dem_configured": 1717.0}, "configured", 0.05) is not None
 
 
 def test_verification_table_shows_the_surrogates_at_the_verified_set(tmp_path):
