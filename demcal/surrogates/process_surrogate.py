@@ -6,7 +6,10 @@ offers: a file, a float32 ``predict_torch`` over chunks and no scikit-learn at s
 :class:`ProcessSurrogate` keeps the posterior mean of a fitted
 :func:`demcal.surrogates.baselines.gaussian_process_regression` pipeline,
 
-    y(x) = y_mean + y_std * sum_i alpha_i * c * exp(-|(x' - x_i) / l|^2 / 2),
+    y(x) = y_mean + y_std * sum_i alpha_i * c * k(|(x' - x_i) / l|),
+
+    k(r) = (1 + sqrt(5) r + 5 r^2 / 3) exp(-sqrt(5) r)     (Matern 5/2, ``kernel: matern52``)
+    k(r) = exp(-r^2 / 2)                                    (``kernel: rbf``, files before it)
 
 where ``x'`` is ``x`` with the logarithm of the log columns, standardised as in training,
 ``x_i`` the standardised training inputs, ``alpha`` the process's weights (the white-noise
@@ -23,6 +26,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 import torch
+from sklearn.gaussian_process.kernels import RBF, Matern
 from sklearn.pipeline import Pipeline
 
 from demcal.surrogates.grid_evaluation import evaluate_in_chunks
@@ -31,6 +35,20 @@ from demcal.surrogates.surrogate_json import read_surrogate_json, write_surrogat
 
 #: Format tag of the file.
 PROCESS_FORMAT = "demcal-gaussian-process-1"
+
+#: Kernels a process file may name; files without the field hold an RBF process.
+KERNELS = ("matern52", "rbf")
+
+_SQRT5 = 5.0**0.5
+
+
+def _correlation(sq: Any, kernel: str) -> Any:
+    """Kernel value of squared scaled distances ``sq`` (numpy array or torch tensor, >= 0)."""
+    if kernel == "rbf":
+        return (-0.5 * sq).exp() if isinstance(sq, torch.Tensor) else np.exp(-0.5 * sq)
+    r = sq.sqrt() if isinstance(sq, torch.Tensor) else np.sqrt(sq)
+    decay = (-_SQRT5 * r).exp() if isinstance(sq, torch.Tensor) else np.exp(-_SQRT5 * r)
+    return (1.0 + _SQRT5 * r + (5.0 / 3.0) * sq) * decay
 
 
 class ProcessSurrogate:
@@ -49,11 +67,13 @@ class ProcessSurrogate:
     alpha : array_like, shape (n,)
         Weights of the training points (normalised target units).
     length_scales : array_like, shape (d,)
-        RBF length scales in standardised input units.
+        Kernel length scales in standardised input units.
     signal_variance : float
         Constant factor ``c`` of the kernel.
     y_mean, y_std : float
         Target normalisation, units of the bulk value.
+    kernel : {"matern52", "rbf"}, default "matern52"
+        Correlation function (module docstring).
     """
 
     def __init__(
@@ -68,7 +88,11 @@ class ProcessSurrogate:
         signal_variance: float,
         y_mean: float,
         y_std: float,
+        kernel: str = "matern52",
     ) -> None:
+        if kernel not in KERNELS:
+            raise ValueError(f"unknown process kernel {kernel!r}; expected one of {KERNELS}")
+        self.kernel = kernel
         self.features = [str(f) for f in features]
         self.log_inputs = tuple(int(c) for c in log_inputs)
         self.x_mean = np.asarray(x_mean, dtype=np.float64)
@@ -103,6 +127,13 @@ class ProcessSurrogate:
         scaler = pipeline.named_steps["scale"]
         gp = pipeline.named_steps["regressor"].gp_
         kernel = gp.kernel_
+        correlation = kernel.k1.k2
+        if isinstance(correlation, Matern) and correlation.nu == 2.5:
+            name = "matern52"
+        elif isinstance(correlation, RBF):
+            name = "rbf"
+        else:
+            raise ValueError(f"no process file for the kernel {correlation!r}")
         return cls(
             features=features,
             log_inputs=pipeline_log_columns(pipeline),
@@ -114,6 +145,7 @@ class ProcessSurrogate:
             signal_variance=kernel.k1.k1.constant_value,
             y_mean=float(np.atleast_1d(gp._y_train_mean)[0]),
             y_std=float(np.atleast_1d(gp._y_train_std)[0]),
+            kernel=name,
         )
 
     def _standardised(self, X: np.ndarray) -> np.ndarray:
@@ -135,7 +167,7 @@ class ProcessSurrogate:
         xs = self._standardised(np.asarray(X, dtype=np.float64)) / self.length_scales
         xt = self.x_train / self.length_scales
         sq = (xs**2).sum(1)[:, None] + (xt**2).sum(1)[None, :] - 2.0 * xs @ xt.T
-        k = self.signal_variance * np.exp(-0.5 * np.maximum(sq, 0.0))
+        k = self.signal_variance * _correlation(np.maximum(sq, 0.0), self.kernel)
         return self.y_mean + self.y_std * (k @ self.alpha)
 
     def predict_torch(self, X: torch.Tensor, chunk_size: int = 32_768) -> torch.Tensor:
@@ -164,7 +196,7 @@ class ProcessSurrogate:
         def posterior_mean(chunk: torch.Tensor) -> torch.Tensor:
             xs = chunk * inv - shift
             sq = (xs**2).sum(1, keepdim=True) + xt_sq - 2.0 * xs @ xt.T
-            return torch.exp(-0.5 * sq.clamp_min_(0.0)) @ weights + self.y_mean
+            return _correlation(sq.clamp_min_(0.0), self.kernel) @ weights + self.y_mean
 
         return evaluate_in_chunks(
             X, len(self.features), self.log_inputs, chunk_size, posterior_mean
@@ -184,6 +216,7 @@ class ProcessSurrogate:
             "signal_variance": self.signal_variance,
             "y_mean": self.y_mean,
             "y_std": self.y_std,
+            "kernel": self.kernel,
         }
 
     def save(self, path: str | Path, metadata: dict[str, Any] | None = None) -> Path:
@@ -197,7 +230,8 @@ class ProcessSurrogate:
         Raises
         ------
         ValueError
-            If the file is not a process of this format or its arrays disagree in shape.
+            If the file is not a process of this format, names an unknown kernel or its arrays
+            disagree in shape.
         """
         keys = (
             "features",
@@ -211,4 +245,8 @@ class ProcessSurrogate:
             "y_mean",
             "y_std",
         )
-        return cls(**read_surrogate_json(path, PROCESS_FORMAT, "Gaussian-process", keys))
+        return cls(
+            **read_surrogate_json(
+                path, PROCESS_FORMAT, "Gaussian-process", keys, optional={"kernel": "rbf"}
+            )
+        )

@@ -29,7 +29,11 @@ def write_surrogate_json(
 
 
 def read_surrogate_json(
-    path: str | Path, file_format: str, kind: str, keys: Sequence[str]
+    path: str | Path,
+    file_format: str,
+    kind: str,
+    keys: Sequence[str],
+    optional: Mapping[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The ``keys`` of a file written by :func:`write_surrogate_json`.
 
@@ -43,6 +47,9 @@ def read_surrogate_json(
         What the file holds, for the error message (e.g. ``"Gaussian-process"``).
     keys : sequence of str
         The fields to return.
+    optional : mapping, optional
+        Further fields to return, with the value taken when the file lacks one (a field added
+        to the format later, so that files written before it still read).
 
     Raises
     ------
@@ -57,4 +64,4 @@ def read_surrogate_json(
     missing = [k for k in keys if k not in data]
     if missing:
         raise ValueError(f"{path}: {kind} file without {', '.join(missing)}")
-    return {k: data[k] for k in keys}
+    return {k: data[k] for k in keys} | {k: data.get(k, v) for k, v in (optional or {}).items()}

@@ -11,8 +11,13 @@ import numpy as np
 import pandas as pd
 import pytest
 import torch
+from sklearn.gaussian_process.kernels import RBF, ConstantKernel, Kernel, WhiteKernel
 
-from demcal.surrogates.baselines import bayesian_linear_regression, gaussian_process_regression
+from demcal.surrogates.baselines import (
+    AnisotropicGaussianProcess,
+    bayesian_linear_regression,
+    gaussian_process_regression,
+)
 from demcal.surrogates.linear_surrogate import LinearSurrogate
 from demcal.surrogates.network import MLPSurrogate
 from demcal.surrogates.process_surrogate import ProcessSurrogate
@@ -60,6 +65,44 @@ def test_process_predicts_as_the_fitted_pipeline(tmp_path: Path) -> None:
         ProcessSurrogate.load(tmp_path / "bad.json")
     with pytest.raises(ValueError, match=r"shape \(n, 4\)"):
         process.predict_torch(torch.zeros(3, 5))
+
+
+class _RBFProcess(AnisotropicGaussianProcess):
+    """The squared-exponential process the files written before the Matern kernel hold."""
+
+    def _kernel(self, n_features: int) -> Kernel:
+        return ConstantKernel(1.0, (1e-3, 1e3)) * RBF(np.ones(n_features), (1e-2, 1e3)) + (
+            WhiteKernel(1e-2, (1e-8, 1.0))
+        )
+
+
+def test_the_process_file_names_its_kernel_and_reads_older_files_as_rbf(tmp_path: Path) -> None:
+    X = _inputs(40, seed=6)
+    y = 0.45 + 0.08 * np.log(X[:, 0]) + 0.2 * X[:, 1] ** 2 + 2e-6 * X[:, 3]
+    grid = _inputs(500, seed=7)
+    matern = gaussian_process_regression(seed=0, log_inputs=(0,)).fit(X, y)
+    assert ProcessSurrogate.from_pipeline(matern, FEATURES).kernel == "matern52"
+    rbf = gaussian_process_regression(seed=0, log_inputs=(0,))
+    rbf.set_params(regressor=_RBFProcess(random_state=0)).fit(X, y)
+    process = ProcessSurrogate.from_pipeline(rbf, FEATURES)
+    assert process.kernel == "rbf"
+    np.testing.assert_allclose(process.predict(grid), rbf.predict(grid), rtol=0.0, atol=1e-8)
+    # The field is read: the same weights under the other kernel predict something else.
+    fields = {k: v for k, v in process.to_dict().items() if k != "format"}
+    misread = ProcessSurrogate(**(fields | {"kernel": "matern52"}))
+    assert np.abs(misread.predict(grid) - rbf.predict(grid)).max() > 1e-2
+    path = process.save(tmp_path / "process.json")
+    data = json.loads(path.read_text())
+    assert data["kernel"] == "rbf"
+    del data["kernel"]  # a file written before the field existed
+    path.write_text(json.dumps(data))
+    old = ProcessSurrogate.load(path)
+    assert old.kernel == "rbf"
+    np.testing.assert_allclose(old.predict(grid), rbf.predict(grid), rtol=0.0, atol=1e-8)
+    data["kernel"] = "cubic"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ValueError, match="unknown process kernel 'cubic'"):
+        ProcessSurrogate.load(path)
 
 
 def test_linear_surrogate_predicts_as_the_fitted_pipeline(tmp_path: Path) -> None:
