@@ -130,9 +130,15 @@ def mean_interval(values_mean: float, sd: float, runs: int) -> tuple[float, floa
     return values_mean - half, values_mean + half
 
 
+def _stated_sd(row: Mapping[str, Any]) -> float | None:
+    """The measured value's sd when its experiment file states a positive one."""
+    sd = float(row.get("measured_sd", math.nan))
+    return sd if math.isfinite(sd) and sd > 0.0 else None
+
+
 def verdict_interval(row: Mapping[str, Any], engine: str) -> tuple[float, float] | None:
-    """Interval of the true value of the runs' mean minus the measurement, put back on the
-    scale of the runs' mean.
+    """The interval a verdict compares with the tolerance band: the runs' mean with its own
+    and the measurement's uncertainty.
 
     The Student-t interval of the runs' mean (:func:`mean_interval`) is widened in quadrature by
     the measured value's own uncertainty, ``z * measured_sd`` with z the normal quantile of
@@ -158,8 +164,8 @@ def verdict_interval(row: Mapping[str, Any], engine: str) -> tuple[float, float]
     sd, runs = scatter_columns(engine)
     mean = float(row[dem])
     interval = mean_interval(mean, float(row[sd]), int(row[runs]))
-    measured_sd = float(row.get("measured_sd", math.nan))
-    if interval is None or not (math.isfinite(measured_sd) and measured_sd > 0.0):
+    measured_sd = _stated_sd(row)
+    if interval is None or measured_sd is None:
         return interval
     z = float(norm.ppf(0.5 + 0.5 * CONFIDENCE))
     half = math.hypot(0.5 * (interval[1] - interval[0]), z * measured_sd)
@@ -172,11 +178,8 @@ def undecided(row: Mapping[str, Any], engine: str, tolerance: float) -> str | No
 
     Parameters
     ----------
-    row : mapping
-        One row of a verification table (``measured``, ``measured_sd``, ``dem_<engine>``,
-        ``dem_sd_<engine>``, ``runs_<engine>``).
-    engine : str
-        The engine whose columns are read.
+    row, engine
+        As for :func:`verdict_interval`.
     tolerance : float
         The relative tolerance (e.g. 0.05).
 
@@ -195,12 +198,8 @@ def undecided(row: Mapping[str, Any], engine: str, tolerance: float) -> str | No
         return None  # one run or no value, or the interval wholly outside the band
     if band[0] <= interval[0] and interval[1] <= band[1]:
         return None  # wholly inside
-    measured_sd = float(row.get("measured_sd", math.nan))
-    widened = (
-        f", with the measured sd {measured_sd:.3g}:"
-        if math.isfinite(measured_sd) and measured_sd > 0.0
-        else ""
-    )
+    measured_sd = _stated_sd(row)
+    widened = f", with the measured sd {measured_sd:.3g}:" if measured_sd is not None else ""
     return (
         f"{_condition(row)} {float(row[dem]):.4g} ({CONFIDENCE:.0%} interval of the mean of "
         f"{int(row[runs])} runs{widened} {interval[0]:.4g}-{interval[1]:.4g}, tolerance band "
