@@ -44,11 +44,11 @@ _SQRT5 = 5.0**0.5
 
 def _correlation(sq: Any, kernel: str) -> Any:
     """Kernel value of squared scaled distances ``sq`` (numpy array or torch tensor, >= 0)."""
+    xp = torch if isinstance(sq, torch.Tensor) else np
     if kernel == "rbf":
-        return (-0.5 * sq).exp() if isinstance(sq, torch.Tensor) else np.exp(-0.5 * sq)
-    r = sq.sqrt() if isinstance(sq, torch.Tensor) else np.sqrt(sq)
-    decay = (-_SQRT5 * r).exp() if isinstance(sq, torch.Tensor) else np.exp(-_SQRT5 * r)
-    return (1.0 + _SQRT5 * r + (5.0 / 3.0) * sq) * decay
+        return xp.exp(-0.5 * sq)
+    r = xp.sqrt(sq)
+    return (1.0 + _SQRT5 * r + (5.0 / 3.0) * sq) * xp.exp(-_SQRT5 * r)
 
 
 class ProcessSurrogate:
@@ -130,7 +130,7 @@ class ProcessSurrogate:
         correlation = kernel.k1.k2
         if isinstance(correlation, Matern) and correlation.nu == 2.5:
             name = "matern52"
-        elif isinstance(correlation, RBF):
+        elif type(correlation) is RBF:  # Matern derives from RBF
             name = "rbf"
         else:
             raise ValueError(f"no process file for the kernel {correlation!r}")

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import torch
-from sklearn.gaussian_process.kernels import RBF, ConstantKernel, Kernel, WhiteKernel
+from sklearn.gaussian_process.kernels import RBF, ConstantKernel, Kernel, Matern, WhiteKernel
 
 from demcal.surrogates.baselines import (
     AnisotropicGaussianProcess,
@@ -76,6 +76,13 @@ class _RBFProcess(AnisotropicGaussianProcess):
         )
 
 
+class _Matern32Process(AnisotropicGaussianProcess):
+    """A kernel the process file cannot describe (Matern derives from RBF in scikit-learn)."""
+
+    def _kernel(self, n_features: int) -> Kernel:
+        return ConstantKernel() * Matern(np.ones(n_features), nu=1.5) + WhiteKernel()
+
+
 def test_the_process_file_names_its_kernel_and_reads_older_files_as_rbf(tmp_path: Path) -> None:
     X = _inputs(40, seed=6)
     y = 0.45 + 0.08 * np.log(X[:, 0]) + 0.2 * X[:, 1] ** 2 + 2e-6 * X[:, 3]
@@ -99,6 +106,10 @@ def test_the_process_file_names_its_kernel_and_reads_older_files_as_rbf(tmp_path
     old = ProcessSurrogate.load(path)
     assert old.kernel == "rbf"
     np.testing.assert_allclose(old.predict(grid), rbf.predict(grid), rtol=0.0, atol=1e-8)
+    other = gaussian_process_regression(seed=0, log_inputs=(0,))
+    other.set_params(regressor=_Matern32Process(random_state=0)).fit(X, y)
+    with pytest.raises(ValueError, match="no process file for the kernel Matern"):
+        ProcessSurrogate.from_pipeline(other, FEATURES)
     data["kernel"] = "cubic"
     path.write_text(json.dumps(data))
     with pytest.raises(ValueError, match="unknown process kernel 'cubic'"):
