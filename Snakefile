@@ -14,7 +14,7 @@ include: "workflow/rules/common.smk"
 wildcard_constraints:
     test="shear_cell|angle_of_repose",
     case=r"[A-Za-z0-9]+(_r\d+)?(_s\d+(_p\d+)?|_h\d+)?",
-    stage="cases|verification/[a-z][a-z0-9_]*|sequential/round_[0-9]+/verification|discrepancy/probes|discrepancy/extended|discrepancy/verification",
+    stage="cases|verification/[a-z][a-z0-9_]*|sequential/round_[0-9]+/verification|discrepancy/probes|discrepancy/reprobes|discrepancy/extended|discrepancy/verification",
     engine="[a-z][a-z0-9_]*",
     output="mu_psh|mu_sh|rho_b|aor",
 

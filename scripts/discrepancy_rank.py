@@ -19,6 +19,9 @@ def main(snakemake) -> None:
             out.record,
             out.probes,
             out.design,
+            snakemake.input.lead,
+            snakemake.input.reprobes,
+            out.reprobes,
         )
         if result is None:
             logger.info("nothing missing; ranking not run")

@@ -41,6 +41,7 @@ __all__ = [
     "measured_tests",
     "parse_candidates",
     "probe_runs",
+    "reprobe_runs",
     "run_suffixes",
 ]
 
@@ -101,6 +102,12 @@ class Candidate:
     def case_id(self, level_index: int) -> str:
         """Case id of the probe run at ``probe_levels[level_index]`` (e.g. ``cohesion1``)."""
         return f"{self.name}{level_index + 1}"
+
+    @property
+    def reference_case(self) -> str:
+        """Case id of the run with the effect absent at the candidate's own best fit, where it
+        is probed again (``cohesion0``; :func:`reprobe_runs`)."""
+        return f"{self.name}0"
 
 
 def parse_candidates(entries: Sequence[Mapping[str, Any]]) -> list[Candidate]:
@@ -275,11 +282,24 @@ class ProbeRun:
     level: float | None
 
 
+def _level_runs(cand: Candidate) -> list[ProbeRun]:
+    return [ProbeRun(cand.case_id(j), cand.name, v) for j, v in enumerate(cand.probe_levels)]
+
+
 def probe_runs(candidates: Sequence[Candidate]) -> list[ProbeRun]:
     """The probe points: the reference run, then every candidate at each of its levels."""
     runs = [ProbeRun(REFERENCE_CASE, None, None)]
     for cand in candidates:
-        runs += [ProbeRun(cand.case_id(j), cand.name, v) for j, v in enumerate(cand.probe_levels)]
+        runs += _level_runs(cand)
+    return runs
+
+
+def reprobe_runs(candidates: Sequence[Candidate]) -> list[ProbeRun]:
+    """The runs of candidates probed again at their own best fit: for each, the reference with
+    the effect absent (its :attr:`Candidate.reference_case`), then every level."""
+    runs = []
+    for cand in candidates:
+        runs += [ProbeRun(cand.reference_case, None, None), *_level_runs(cand)]
     return runs
 
 

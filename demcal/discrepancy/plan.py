@@ -23,6 +23,7 @@ from demcal.discrepancy.candidates import (
     measured_tests,
     parse_candidates,
     probe_runs,
+    reprobe_runs,
     run_suffixes,
 )
 from demcal.discrepancy.dem_check import fitted_experiment, held_out_suffixes, replicate_bases
@@ -127,6 +128,21 @@ class DiscrepancyPlan:
             cases += replicate_bases(run.case, count)
         return cases
 
+    def reprobe_cases(self, refit_record: str | Path) -> list[str]:
+        """Run ids of the candidates probed again at their own best fit (``points`` of the
+        lead record, :func:`demcal.discrepancy.probe_ranking.write_lead`): per candidate the
+        reference ``replicates`` times, then ``probe_replicates`` runs of every level."""
+        names = reprobed(refit_record)
+        cases = []
+        for run in reprobe_runs([c for c in self.candidates if c.name in names]):
+            count = self.replicates if run.candidate is None else self.probe_replicates
+            cases += replicate_bases(run.case, count)
+        return cases
+
+    def reprobe_bulk(self, refit_record: str | Path) -> list[str]:
+        """Bulk files of the runs of :meth:`reprobe_cases` (none when no candidate leads)."""
+        return self.bulk_files("reprobes", self.reprobe_cases(refit_record))
+
     def probe_bulk(self, find_record: str | Path) -> list[str]:
         """Bulk files of all probe runs, or none when Find found nothing missing."""
         return self.bulk_files("probes", self.probe_cases) if missing(find_record) else []
@@ -173,6 +189,11 @@ class DiscrepancyPlan:
 def missing(find_record: str | Path) -> bool:
     """Whether Find rejected "nothing missing"."""
     return bool(json.loads(Path(find_record).read_text())["missing"])
+
+
+def reprobed(refit_record: str | Path) -> list[str]:
+    """Names of the candidates the lead record sends to be probed again at their best fit."""
+    return list(json.loads(Path(refit_record).read_text())["points"])
 
 
 def winner(ranking_record: str | Path) -> str | None:

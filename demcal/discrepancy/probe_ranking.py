@@ -16,6 +16,7 @@ import pandas as pd
 
 from demcal.core.experiments import Experiment, load_experiment
 from demcal.core.provenance import write_sidecar
+from demcal.discrepancy.best_fit import ParameterBox
 from demcal.discrepancy.candidates import (
     REFERENCE_CASE,
     Candidate,
@@ -46,7 +47,7 @@ from demcal.discrepancy.ranking import (
 from demcal.discrepancy.report import condition_label, ranking_markdown
 from demcal.discrepancy.run_results import read_runs, replicate_statistics
 
-__all__ = ["RankingResult", "rank", "ranking_record", "write_ranking"]
+__all__ = ["RankingResult", "lead_points", "rank", "ranking_record", "write_lead", "write_ranking"]
 
 
 @dataclass
@@ -89,25 +90,39 @@ class RankingResult:
     power: pd.DataFrame | None = None
 
 
-def rank(
+@dataclass
+class _Scores:
+    """The candidates' fits on the probe runs, before any test (see :func:`_score`)."""
+
+    model: SurrogateModel
+    box: ParameterBox
+    null: FindResult
+    grid: np.ndarray
+    predictions: np.ndarray
+    weights: np.ndarray
+    null_deviance: float
+    fits: dict
+    responses: dict[str, EffectResponse]
+    rows: list[dict[str, Any]]
+    notes: list[str]
+
+    def ranked(self, min_explained: float) -> tuple[pd.DataFrame, str | None]:
+        """The scored candidates ordered by dBIC, and the leader if it explains enough."""
+        return rank_candidates(
+            self.null_deviance, self.fits, len(self.model.observations), min_explained
+        )
+
+
+def _score(
     model_paths: Mapping[str, str | Path],
     experiment: Experiment,
     config: Mapping[str, Any],
     runs: pd.DataFrame,
     probe_point: Mapping[str, float],
-) -> RankingResult:
-    """Score every applicable candidate with its probe runs and rank them (BIC).
-
-    ``probe_point`` is the parameter set the probes ran at (``point`` of the Find record); it
-    gives the "absent" magnitude of a candidate whose absence is another parameter's value.
-
-    The reference is the mean of the ``discrepancy.replicates`` runs at theta* and a probe
-    level the mean of its ``discrepancy.probe_replicates`` runs, each over the runs that
-    finished. Observations without a value in any reference run are left out of the ranking
-    (and the null fit is redone without them); a probe level without a value in any of its runs
-    is dropped for its candidate; a candidate without any usable level is reported as not
-    scored.
-    """
+    reprobes: pd.DataFrame | None = None,
+    points: Mapping[str, Mapping[str, float]] | None = None,
+) -> _Scores:
+    """Fit every applicable candidate with its probe response (see :func:`rank`)."""
     settings = config["discrepancy"]
     n_reference = int(settings["replicates"])
     n_probe = int(settings["probe_replicates"])
@@ -156,9 +171,20 @@ def rank(
         if not ok:
             rows.append({**row, "status": f"not applicable: {reason}"})
             continue
+        source, own_reference, own_point = runs, reference, point
+        if points and cand.name in points and reprobes is not None and len(reprobes):
+            again = _mean_of_runs(reprobes, cand.reference_case, n_reference, obs)
+            if np.all(np.isfinite(again)):
+                source, own_reference = reprobes, again
+                own_point = {**point, **{k: float(v) for k, v in points[cand.name].items()}}
+            else:
+                notes.append(
+                    f"{cand.name}: scored with its probes at theta* (its reference runs at its "
+                    "own best fit gave no value for every observation)"
+                )
         mags, values = [], []
         for j, level in enumerate(cand.probe_levels):
-            vals = _mean_of_runs(runs, cand.case_id(j), n_probe, obs)
+            vals = _mean_of_runs(source, cand.case_id(j), n_probe, obs)
             if np.all(np.isfinite(vals)):
                 mags.append(level)
                 values.append(vals)
@@ -172,8 +198,8 @@ def rank(
             continue
         response = EffectResponse.from_runs(
             cand.name,
-            [cand.off_magnitude(point), *mags],
-            np.vstack([reference, *values]),
+            [cand.off_magnitude(own_point), *mags],
+            np.vstack([own_reference, *values]),
             reference=0,
             integer=cand.integer,
         )
@@ -191,12 +217,90 @@ def rank(
         )
         fits[cand.name] = fit
         responses[cand.name] = response
-        signature = response_signature(obs, response, reference, noise)
+        signature = response_signature(obs, response, own_reference, noise)
+        if source is not runs:
+            at = ", ".join(f"{k} {own_point[k]:.4g}" for k in box.names if k in own_point)
+            notes.append(f"{cand.name}: scored with its probe runs at its own best fit ({at})")
         rows.append({**row, "status": "scored", "signature": signature})
-    # dBIC orders the candidates; the bootstrap tests below decide whether the top one is named.
-    scored, winner_name = rank_candidates(
-        null_weighted.deviance, fits, len(obs), float(settings["min_explained"])
+    return _Scores(
+        model,
+        box,
+        null,
+        grid,
+        predictions,
+        weights,
+        null_weighted.deviance,
+        fits,
+        responses,
+        rows,
+        notes,
     )
+
+
+def lead_points(
+    model_paths: Mapping[str, str | Path],
+    experiment: Experiment,
+    config: Mapping[str, Any],
+    runs: pd.DataFrame,
+    probe_point: Mapping[str, float],
+) -> dict[str, dict[str, float]]:
+    """The best fit of each of the ``discrepancy.reprobe`` leading candidates, where they are
+    probed again before the naming.
+
+    A response measured at theta* is added to the surrogate everywhere; a missing effect can
+    drag theta* far from where the model extended by it fits, so the leaders are probed again
+    at their own best fit (one step of relinearisation) and scored with those responses.
+
+    Returns
+    -------
+    dict
+        Candidate -> complete parameter set (``probe_point`` with the candidate's best-fit
+        values of the free parameters), in dBIC order; empty when no candidate was scored.
+    """
+    count = int(config["discrepancy"]["reprobe"])
+    if count == 0:
+        return {}
+    scores = _score(model_paths, experiment, config, runs, probe_point)
+    table, _ = scores.ranked(float(config["discrepancy"]["min_explained"]))
+    names = [str(n) for n in table.sort_values("rank")["candidate"]][:count]
+    base = {k: float(v) for k, v in probe_point.items()}
+    return {n: {**base, **scores.fits[n].best.theta} for n in names}
+
+
+def rank(
+    model_paths: Mapping[str, str | Path],
+    experiment: Experiment,
+    config: Mapping[str, Any],
+    runs: pd.DataFrame,
+    probe_point: Mapping[str, float],
+    reprobes: pd.DataFrame | None = None,
+    points: Mapping[str, Mapping[str, float]] | None = None,
+) -> RankingResult:
+    """Score every applicable candidate with its probe runs and rank them (BIC).
+
+    ``probe_point`` is the parameter set the probes ran at (``point`` of the Find record); it
+    gives the "absent" magnitude of a candidate whose absence is another parameter's value.
+    A candidate in ``points`` (:func:`lead_points`) is scored with its runs in ``reprobes``
+    instead: its reference (run :attr:`~demcal.discrepancy.candidates.Candidate.reference_case`)
+    and levels at its own best fit.
+
+    The reference is the mean of the ``discrepancy.replicates`` runs at theta* and a probe
+    level the mean of its ``discrepancy.probe_replicates`` runs, each over the runs that
+    finished. Observations without a value in any reference run are left out of the ranking
+    (and the null fit is redone without them); a probe level without a value in any of its runs
+    is dropped for its candidate; a candidate without any usable level is reported as not
+    scored.
+    """
+    settings = config["discrepancy"]
+    scores = _score(model_paths, experiment, config, runs, probe_point, reprobes, points)
+    obs = scores.model.observations
+    notes = scores.notes
+    fits, responses = scores.fits, scores.responses
+    predictions, weights = scores.predictions, scores.weights
+    candidates = parse_candidates(settings["candidates"])
+    # dBIC orders the candidates; the bootstrap tests below decide whether the top one is named.
+    scored, winner_name = scores.ranked(float(settings["min_explained"]))
+    rows = scores.rows
     unscored = [r["candidate"] for r in rows if r["status"].startswith("not scored")]
     if winner_name is not None and unscored:
         notes.append(
@@ -204,31 +308,40 @@ def rank(
         )
         winner_name = None
     y = obs["measured"].to_numpy(float)
-    alpha, points = float(settings["alpha"]), int(settings["magnitude_points"])
+    alpha, points_m = float(settings["alpha"]), int(settings["magnitude_points"])
     boot = int(settings["bootstrap_draws"])
     test = None
     if responses:
-        test = naming_test(predictions, y, weights, responses, points, boot)
+        test = naming_test(predictions, y, weights, responses, points_m, boot)
     power = None
     if test is not None and int(settings["power_draws"]) > 0:
         draws = int(settings["power_draws"])
         power = naming_power(
-            predictions, y, weights, responses, alpha, points, draws, null_drops=test.null_drops
+            predictions, y, weights, responses, alpha, points_m, draws, null_drops=test.null_drops
         )
         # Each candidate the data cannot name, again with one parameter held at a time.
-        hold = partial(power_with_fixed, grid, predictions, list(box.names), y, weights, responses)
-        fixed = {c: hold(c, alpha, points, draws, boot) for c in _unnameable(power)}
+        hold = partial(
+            power_with_fixed,
+            scores.grid,
+            predictions,
+            list(scores.box.names),
+            y,
+            weights,
+            responses,
+        )
+        fixed = {c: hold(c, alpha, points_m, draws, boot) for c in _unnameable(power)}
         notes += _power_notes(power, fixed)
     ambiguous = None
     if winner_name is not None and test is not None:
         winner_name, ambiguous = _tested_winner(
             winner_name, test, float(settings["alpha"]), obs, notes
         )
-    if winner_name is not None and len(obs) < null.n_free + 2:
+    if winner_name is not None and len(obs) < scores.null.n_free + 2:
         # A candidate adds one parameter: with N <= d + 1 it can fit every value exactly.
         notes.append(
             f"{winner_name} leads, but is not named: {len(obs)} measured values cannot tell "
-            f"{null.n_free + 1} fitted parameters apart (at least {null.n_free + 2} needed)"
+            f"{scores.null.n_free + 1} fitted parameters apart (at least "
+            f"{scores.null.n_free + 2} needed)"
         )
         winner_name = None
     info = pd.DataFrame(rows)
@@ -242,7 +355,7 @@ def rank(
         table["power"] = table["candidate"].map(_power_text(power))
     winner = next((c for c in candidates if c.name == winner_name), None)
     return RankingResult(
-        table, winner, fits, null, null_weighted.deviance, notes, test, ambiguous, power
+        table, winner, fits, scores.null, scores.null_deviance, notes, test, ambiguous, power
     )
 
 
@@ -389,6 +502,9 @@ def write_ranking(
     record_path: str | Path,
     probes_path: str | Path,
     design_path: str | Path,
+    lead_record_path: str | Path | None = None,
+    reprobe_files: Iterable[str | Path] = (),
+    reprobes_path: str | Path | None = None,
 ) -> RankingResult | None:
     """Rank the candidates and write the ranking, its record and the extended design.
 
@@ -413,6 +529,12 @@ def write_ranking(
         All probe-run rows (CSV) to write.
     design_path : path
         Extended design of the named effect (CSV; only the header when none is named).
+    lead_record_path : path, optional
+        Record of :func:`write_lead`: the candidates probed again at their own best fit.
+    reprobe_files : iterable of path
+        ``bulk.csv`` of those runs.
+    reprobes_path : path, optional
+        Their rows (CSV) to write.
 
     Returns
     -------
@@ -431,12 +553,23 @@ def write_ranking(
         Path(record_path).write_text(json.dumps(record, indent=2) + "\n")
         _empty(design_path, ["case_id"])
         _empty(probes_path, ["case_id"])
+        if reprobes_path is not None:
+            _empty(reprobes_path, ["case_id"])
         return None
     # Held-out loads are kept for the DEM check of the Show step.
     experiment = fitted_experiment(load_experiment(experiment_path), config)
     runs = read_runs(probe_files)
     runs.to_csv(probes_path, index=False, float_format="%.8g")
-    result = rank(model_paths, experiment, config, runs, find_rec["point"])
+    points = {}
+    if lead_record_path is not None:
+        points = json.loads(Path(lead_record_path).read_text())["points"]
+    reprobes = read_runs(reprobe_files)
+    if reprobes_path is not None:
+        if len(reprobes):
+            reprobes.to_csv(reprobes_path, index=False, float_format="%.8g")
+        else:
+            _empty(reprobes_path, ["case_id"])
+    result = rank(model_paths, experiment, config, runs, find_rec["point"], reprobes, points)
     result.table.to_csv(table_path, index=False, float_format="%.6g")
     Path(markdown_path).write_text(
         ranking_markdown(
@@ -456,6 +589,50 @@ def write_ranking(
         design.to_csv(design_path, index=False, float_format="%.12g")
     else:
         _empty(design_path, ["case_id"])
-    Path(record_path).write_text(json.dumps(ranking_record(result), indent=2) + "\n")
+    record = {**ranking_record(result), "probed_again_at": points}
+    Path(record_path).write_text(json.dumps(record, indent=2) + "\n")
     write_sidecar(record_path, config)
     return result
+
+
+def write_lead(
+    model_paths: Mapping[str, str | Path],
+    experiment_path: str | Path,
+    config: Mapping[str, Any],
+    find_record_path: str | Path,
+    probe_files: Iterable[str | Path],
+    record_path: str | Path,
+) -> dict[str, dict[str, float]]:
+    """Write the points where the leading candidates are probed again (:func:`lead_points`).
+
+    Parameters
+    ----------
+    model_paths : mapping
+        Observable -> saved surrogate of the current model.
+    experiment_path : path
+        The experiment file with the measurements.
+    config : mapping
+        The validated configuration.
+    find_record_path : path
+        Record of the Find step.
+    probe_files : iterable of path
+        ``bulk.csv`` of every probe run at theta* (none when nothing is missing).
+    record_path : path
+        The record (JSON): ``points``, candidate -> complete parameter set (SI units); empty
+        when nothing is missing, no candidate was scored or ``discrepancy.reprobe`` is 0.
+
+    Returns
+    -------
+    dict
+        The ``points`` written.
+    """
+    find_rec = json.loads(Path(find_record_path).read_text())
+    points: dict[str, dict[str, float]] = {}
+    if find_rec["missing"]:
+        experiment = fitted_experiment(load_experiment(experiment_path), config)
+        runs = read_runs(probe_files)
+        points = lead_points(model_paths, experiment, config, runs, find_rec["point"])
+    record = {"reprobe": int(config["discrepancy"]["reprobe"]), "points": points}
+    Path(record_path).write_text(json.dumps(record, indent=2) + "\n")
+    write_sidecar(record_path, config)
+    return points

@@ -56,8 +56,10 @@ def discrepancy_case(
 
     Parameters
     ----------
-    mode : {"probe", "extended", "verification"}
+    mode : {"probe", "reprobe", "extended", "verification"}
         probe: the reference or a candidate level at theta* (``record`` = Find record);
+        reprobe: a candidate's reference or level at its own best fit (``record`` = lead
+        record, its ``points``);
         extended: a row of the extended design (``record`` = ranking record, ``design``);
         verification: the extended model's best point (``record`` = recalibration record).
     test, case : str
@@ -81,6 +83,17 @@ def discrepancy_case(
                 if cand.case_id(j) == run:
                     return case_setup(test, case, point, config, cand, level)
         raise KeyError(f"probe case {case!r}: no candidate level of that name")
+    if mode == "reprobe":
+        for cand in parse_candidates(config["discrepancy"]["candidates"]):
+            point = record["points"].get(cand.name)
+            if point is None:
+                continue
+            if run == cand.reference_case:
+                return case_setup(test, case, dict(point), config, None, None)
+            for j, level in enumerate(cand.probe_levels):
+                if cand.case_id(j) == run:
+                    return case_setup(test, case, dict(point), config, cand, level)
+        raise KeyError(f"reprobe case {case!r}: no run of a candidate probed again")
     if mode == "extended":
         if design is None:
             raise ValueError("extended case: the extended design table is needed")
@@ -95,7 +108,7 @@ def discrepancy_case(
         cand = candidate_by_name(config, str(record["winner"]))
         point = dict(record["point"])
         return case_setup(test, case, point, config, cand, float(record["magnitude"]))
-    raise ValueError(f"unknown mode {mode!r}; expected probe, extended or verification")
+    raise ValueError(f"unknown mode {mode!r}; expected probe, reprobe, extended or verification")
 
 
 def render_discrepancy_run(
@@ -111,8 +124,9 @@ def render_discrepancy_run(
     """Render one probe, extended-design or verification run (deck file ``deck``), logging to
     ``log``.
 
-    ``record_path`` is the Find record (probe), the ranking record (extended, with
-    ``design_path``) or the recalibration record (verification); see :func:`discrepancy_case`.
+    ``record_path`` is the Find record (probe), the lead record (reprobe), the ranking record
+    (extended, with ``design_path``) or the recalibration record (verification); see
+    :func:`discrepancy_case`.
 
     Returns
     -------

@@ -2,6 +2,7 @@
 
 import copy
 import dataclasses
+import json
 from pathlib import Path
 
 import pytest
@@ -17,9 +18,11 @@ from demcal.discrepancy.candidates import (
     extended_design,
     parse_candidates,
     probe_runs,
+    reprobe_runs,
     run_suffixes,
 )
 from demcal.discrepancy.plan import DiscrepancyPlan
+from demcal.discrepancy.runs import discrepancy_case
 from demcal.discrepancy.synthetic import study_config
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -184,3 +187,40 @@ def test_probe_runs_and_plan_file_lists(study, tmp_path):
     assert inputs["verification"] == [
         f.replace("probes", "verification").replace("ref", "verify") for f in reference
     ]
+
+
+def test_leading_candidates_are_probed_again_at_their_own_best_fit(study, tmp_path):
+    cands = parse_candidates(study["discrepancy"]["candidates"])
+    # Each candidate probed again has its own reference (effect absent) beside its levels.
+    assert [r.case for r in reprobe_runs(cands[:1])] == [
+        "cohesion0", "cohesion1", "cohesion2", "cohesion3"
+    ]  # fmt: skip
+    assert [r.candidate for r in reprobe_runs(cands[:1])] == [None, *["cohesion"] * 3]
+    plan = DiscrepancyPlan(
+        "results/discrepancy", ["shear_cell"], ["_s1"], [], cands, [], 2, probe_replicates=1
+    )
+    lead = tmp_path / "lead.json"
+    lead.write_text(json.dumps({"points": {}}))
+    assert plan.reprobe_bulk(lead) == []
+    theta_star = base_point({"coefficientFriction": 0.87, "density": 2800.0}, study)
+    own = {**theta_star, "coefficientFriction": 0.42}
+    rolling = next(c for c in cands if c.name == "rolling")
+    lead.write_text(json.dumps({"points": {"rolling": own}}))
+    # The reference as often as at theta* (2), every level probe_replicates times (1).
+    assert plan.reprobe_cases(lead) == ["rolling0", "rolling0_r2"] + [
+        rolling.case_id(j) for j in range(len(rolling.probe_levels))
+    ]
+    assert plan.reprobe_bulk(lead)[0] == (
+        "results/discrepancy/reprobes/shear_cell/rolling0_s1/bulk.csv"
+    )
+    # The decks: the candidate's own best fit, the effect off in its reference and on at a level.
+    record = json.loads(lead.read_text())
+    row, _ = discrepancy_case("reprobe", "shear_cell", "rolling0_r2_s1_p1", study, record)
+    assert row["coefficientFriction"] == 0.42 and row["discrepancy_candidate"] == "none"
+    row, cfg = discrepancy_case("reprobe", "shear_cell", "rolling2_s1_p1", study, record)
+    assert row["coefficientFriction"] == 0.42 and row["discrepancy_candidate"] == "rolling"
+    assert row["coefficientRollingFriction"] == rolling.probe_levels[1]
+    assert cfg["material"]["rolling_friction"] is True
+    # A candidate that leads nowhere has no run there.
+    with pytest.raises(KeyError, match="no run of a candidate probed again"):
+        discrepancy_case("reprobe", "shear_cell", "cohesion1_s1_p1", study, record)

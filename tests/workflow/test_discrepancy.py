@@ -238,6 +238,37 @@ def test_no_hidden_effect_names_none(studies):
     assert "Not run" in (studies["none"] / "results" / "discrepancy" / "ranking.md").read_text()
     # Nothing beyond Find was run.
     assert not (studies["none"] / "results" / "discrepancy" / "probes").exists()
+    assert not (studies["none"] / "results" / "discrepancy" / "reprobes").exists()
+    lead = json.loads((studies["none"] / "results" / "discrepancy" / "lead.json").read_text())
+    assert lead["points"] == {}
+
+
+def test_leaders_are_scored_at_their_own_best_fit(studies):
+    # The two leading candidates on the probes at theta* ran again at their own best fit (the
+    # reference three times, each level once) and were scored with those runs.
+    out = studies["cohesion"] / "results" / "discrepancy"
+    lead = json.loads((out / "lead.json").read_text())
+    record = ranking_record(studies["cohesion"])
+    scored = {r["candidate"] for r in record["ranking"]}
+    assert len(lead["points"]) == min(2, len(scored)) and set(lead["points"]) <= scored, lead
+    assert record["probed_again_at"] == lead["points"]
+    theta_star = json.loads((out / "find.json").read_text())["point"]
+    runs = pd.read_csv(out / "reprobes.csv")
+    ranking = pd.read_csv(out / "ranking.csv").set_index("candidate")
+    notes = (out / "ranking.md").read_text()
+    for name, point in lead["points"].items():
+        assert point.keys() == theta_star.keys()
+        own = runs[runs["run"].str.match(rf"{name}\d")]
+        base = own["run"].str.replace(r"_s\d+(_p\d+)?$", "", regex=True)
+        assert sorted(set(base)) == sorted(
+            {f"{name}0", f"{name}0_r2", f"{name}0_r3"} | {f"{name}{j}" for j in range(1, 4)}
+        ), sorted(set(base))
+        # Every parameter at the candidate's best fit but the candidate's own, which its levels set.
+        parameter = ranking.loc[name, "parameter"]
+        for key in point.keys() - {parameter}:
+            assert own[key].to_numpy() == pytest.approx(point[key], rel=1e-7), (name, key)
+        assert (own.loc[base == f"{name}0", "discrepancy_candidate"] == "none").all()
+        assert f"{name}: scored with its probe runs at its own best fit" in notes
 
 
 def test_hidden_cohesion_moves_the_liggghts_measurements(studies):
@@ -264,8 +295,8 @@ def friction_rise(signature: str, observable: str) -> dict[float, float]:
 
 
 def test_cohesion_signature_weakens_with_stress(studies):
-    # Every study that reached the naming step probed cohesion at its theta*: the signature is
-    # the engine's response to cohesion there, whichever effect was hidden.
+    # Every study that reached the naming step probed cohesion at its theta* or at its own best
+    # fit: the signature is the engine's response to cohesion there, whichever effect was hidden.
     probed = {}
     for name, work in studies.items():
         path = work / "results" / "discrepancy" / "ranking.csv"

@@ -65,9 +65,53 @@ rule discrepancy_render_probe:
         )
 
 
+# The leading candidates' own best fits, where they are probed again (discrepancy.reprobe): a
+# response measured at theta* misleads where the missing effect drags theta* far away.
+checkpoint discrepancy_lead:
+    input:
+        probes=lambda wc: DISC_PLAN.probe_bulk(checkpoints.discrepancy_find.get().output.record),
+        find=f"{DISC}/find.json",
+        models=DISC_PLAN.model_files("current"),
+        experiment=config["experiment"],
+    output:
+        record=f"{DISC}/lead.json",
+    log:
+        f"{LOGS}/discrepancy/lead.log",
+    params:
+        outputs=DISC_PLAN.outputs,
+    threads: 1
+    resources:
+        runtime=resource("analysis", "runtime", 10),
+        mem_mb=resource("analysis", "mem_mb", 2000),
+    conda:
+        CONDA_ENV
+    script:
+        "../../scripts/discrepancy_lead.py"
+
+
+rule discrepancy_render_reprobe:
+    input:
+        record=f"{DISC}/lead.json",
+    output:
+        deck=f"{DISC}/reprobes/{{test}}/{{case}}/in.{{test}}",
+        info=f"{DISC}/reprobes/{{test}}/{{case}}/case.json",
+    log:
+        f"{LOGS}/render/discrepancy/reprobes/{{test}}/{{case}}.log",
+    priority: run_priority  # that of its run (simulate.smk)
+    localrule: True
+    run:
+        render_discrepancy_run(
+            "reprobe", wildcards.test, wildcards.case, config, input.record, output.deck, log[0]
+        )
+
+
 checkpoint discrepancy_rank:
     input:
         probes=lambda wc: DISC_PLAN.probe_bulk(checkpoints.discrepancy_find.get().output.record),
+        lead=f"{DISC}/lead.json",
+        reprobes=lambda wc: DISC_PLAN.reprobe_bulk(
+            checkpoints.discrepancy_lead.get().output.record
+        ),
         find=f"{DISC}/find.json",
         models=DISC_PLAN.model_files("current"),
         experiment=config["experiment"],
@@ -80,6 +124,7 @@ checkpoint discrepancy_rank:
         ),
         record=f"{DISC}/ranking.json",
         probes=f"{DISC}/probes.csv",
+        reprobes=f"{DISC}/reprobes.csv",
         design=f"{DISC}/extended/design.csv",
     log:
         f"{LOGS}/discrepancy/rank.log",
@@ -122,7 +167,11 @@ rule discrepancy_render_extended:
 rule discrepancy_dataset:
     input:
         extended=lambda wc: DISC_PLAN.extended_bulk(checkpoints.discrepancy_rank.get().output.design),
-        probes=lambda wc: DISC_PLAN.probe_bulk(checkpoints.discrepancy_find.get().output.record),
+        # Every run at theta* and at the leaders' best fits: all are rows of the extended model.
+        probes=lambda wc: (
+            DISC_PLAN.probe_bulk(checkpoints.discrepancy_find.get().output.record)
+            + DISC_PLAN.reprobe_bulk(checkpoints.discrepancy_lead.get().output.record)
+        ),
         ranking=f"{DISC}/ranking.json",
         dataset=DATASET,
     output:
