@@ -19,6 +19,7 @@ from demcal.core.experiments import Experiment, load_experiment
 from demcal.discrepancy.candidates import (
     REFERENCE_CASE,
     Candidate,
+    ProbeRun,
     applicability,
     measured_tests,
     parse_candidates,
@@ -122,26 +123,27 @@ class DiscrepancyPlan:
     def probe_cases(self) -> list[str]:
         """Run ids of the probe stage: every replicate of the reference at theta*, then
         ``probe_replicates`` runs of every candidate level."""
-        cases = []
-        for run in probe_runs(self.candidates):
-            count = self.replicates if run.candidate is None else self.probe_replicates
-            cases += replicate_bases(run.case, count)
-        return cases
+        return self._replicated(probe_runs(self.candidates))
 
-    def reprobe_cases(self, refit_record: str | Path) -> list[str]:
+    def reprobe_cases(self, lead_record: str | Path) -> list[str]:
         """Run ids of the candidates probed again at their own best fit (``points`` of the
         lead record, :func:`demcal.discrepancy.probe_ranking.write_lead`): per candidate the
         reference ``replicates`` times, then ``probe_replicates`` runs of every level."""
-        names = reprobed(refit_record)
+        names = reprobed(lead_record)
+        return self._replicated(reprobe_runs([c for c in self.candidates if c.name in names]))
+
+    def reprobe_bulk(self, lead_record: str | Path) -> list[str]:
+        """Bulk files of the runs of :meth:`reprobe_cases` (none when no candidate leads)."""
+        return self.bulk_files("reprobes", self.reprobe_cases(lead_record))
+
+    def _replicated(self, runs: Sequence[ProbeRun]) -> list[str]:
+        """Run ids of every replicate of ``runs``: a reference (no candidate) ``replicates``
+        times, a candidate level ``probe_replicates`` times."""
         cases = []
-        for run in reprobe_runs([c for c in self.candidates if c.name in names]):
+        for run in runs:
             count = self.replicates if run.candidate is None else self.probe_replicates
             cases += replicate_bases(run.case, count)
         return cases
-
-    def reprobe_bulk(self, refit_record: str | Path) -> list[str]:
-        """Bulk files of the runs of :meth:`reprobe_cases` (none when no candidate leads)."""
-        return self.bulk_files("reprobes", self.reprobe_cases(refit_record))
 
     def probe_bulk(self, find_record: str | Path) -> list[str]:
         """Bulk files of all probe runs, or none when Find found nothing missing."""
@@ -191,9 +193,9 @@ def missing(find_record: str | Path) -> bool:
     return bool(json.loads(Path(find_record).read_text())["missing"])
 
 
-def reprobed(refit_record: str | Path) -> list[str]:
+def reprobed(lead_record: str | Path) -> list[str]:
     """Names of the candidates the lead record sends to be probed again at their best fit."""
-    return list(json.loads(Path(refit_record).read_text())["points"])
+    return list(json.loads(Path(lead_record).read_text())["points"])
 
 
 def winner(ranking_record: str | Path) -> str | None:

@@ -96,7 +96,6 @@ class _Scores:
 
     model: SurrogateModel
     box: ParameterBox
-    null: FindResult
     grid: np.ndarray
     predictions: np.ndarray
     weights: np.ndarray
@@ -144,14 +143,6 @@ def _score(
         model = SurrogateModel(surrogates, obs[keep], model.parameters, surrogate_constants(config))
         obs = model.observations
         reference = reference[keep]
-    null = find(
-        model,
-        box,
-        int(settings["grid_points"]),
-        float(settings["alpha"]),
-        float(settings["fit_z"]),
-        draws=int(settings["bootstrap_draws"]),
-    )
     grid = box.grid(int(settings["grid_points"]))
     predictions = model.predict(grid)
     noise = obs["surrogate_rmse"].to_numpy(float)
@@ -225,7 +216,6 @@ def _score(
     return _Scores(
         model,
         box,
-        null,
         grid,
         predictions,
         weights,
@@ -293,6 +283,15 @@ def rank(
     """
     settings = config["discrepancy"]
     scores = _score(model_paths, experiment, config, runs, probe_point, reprobes, points)
+    # Find on the observations the ranking keeps (its bootstrap is the ranking's only use of it).
+    null = find(
+        scores.model,
+        scores.box,
+        int(settings["grid_points"]),
+        float(settings["alpha"]),
+        float(settings["fit_z"]),
+        draws=int(settings["bootstrap_draws"]),
+    )
     obs = scores.model.observations
     notes = scores.notes
     fits, responses = scores.fits, scores.responses
@@ -336,12 +335,11 @@ def rank(
         winner_name, ambiguous = _tested_winner(
             winner_name, test, float(settings["alpha"]), obs, notes
         )
-    if winner_name is not None and len(obs) < scores.null.n_free + 2:
+    if winner_name is not None and len(obs) < null.n_free + 2:
         # A candidate adds one parameter: with N <= d + 1 it can fit every value exactly.
         notes.append(
             f"{winner_name} leads, but is not named: {len(obs)} measured values cannot tell "
-            f"{scores.null.n_free + 1} fitted parameters apart (at least "
-            f"{scores.null.n_free + 2} needed)"
+            f"{null.n_free + 1} fitted parameters apart (at least {null.n_free + 2} needed)"
         )
         winner_name = None
     info = pd.DataFrame(rows)
@@ -355,7 +353,7 @@ def rank(
         table["power"] = table["candidate"].map(_power_text(power))
     winner = next((c for c in candidates if c.name == winner_name), None)
     return RankingResult(
-        table, winner, fits, scores.null, scores.null_deviance, notes, test, ambiguous, power
+        table, winner, fits, null, scores.null_deviance, notes, test, ambiguous, power
     )
 
 

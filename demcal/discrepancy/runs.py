@@ -12,11 +12,13 @@ import pandas as pd
 
 from demcal.core.rule_log import rule_log
 from demcal.discrepancy.candidates import (
-    REFERENCE_CASE,
     Candidate,
+    ProbeRun,
     base_point,
     case_setup,
     parse_candidates,
+    probe_runs,
+    reprobe_runs,
 )
 from demcal.discrepancy.dem_check import parse_run_id
 from demcal.virtual_tests.deck import render_case
@@ -75,24 +77,19 @@ def discrepancy_case(
     """
     run = parse_run_id(case).run
     if mode == "probe":
-        point = dict(record["point"])
-        if run == REFERENCE_CASE:
-            return case_setup(test, case, point, config, None, None)
-        for cand in parse_candidates(config["discrepancy"]["candidates"]):
-            for j, level in enumerate(cand.probe_levels):
-                if cand.case_id(j) == run:
-                    return case_setup(test, case, point, config, cand, level)
-        raise KeyError(f"probe case {case!r}: no candidate level of that name")
+        cands = parse_candidates(config["discrepancy"]["candidates"])
+        found = _run_of(probe_runs(cands), run)
+        if found is None:
+            raise KeyError(f"probe case {case!r}: no candidate level of that name")
+        return _probe_setup(test, case, dict(record["point"]), config, cands, found)
     if mode == "reprobe":
         for cand in parse_candidates(config["discrepancy"]["candidates"]):
-            point = record["points"].get(cand.name)
-            if point is None:
+            if cand.name not in record["points"]:
                 continue
-            if run == cand.reference_case:
-                return case_setup(test, case, dict(point), config, None, None)
-            for j, level in enumerate(cand.probe_levels):
-                if cand.case_id(j) == run:
-                    return case_setup(test, case, dict(point), config, cand, level)
+            found = _run_of(reprobe_runs([cand]), run)
+            if found is not None:
+                point = dict(record["points"][cand.name])
+                return _probe_setup(test, case, point, config, [cand], found)
         raise KeyError(f"reprobe case {case!r}: no run of a candidate probed again")
     if mode == "extended":
         if design is None:
@@ -109,6 +106,25 @@ def discrepancy_case(
         point = dict(record["point"])
         return case_setup(test, case, point, config, cand, float(record["magnitude"]))
     raise ValueError(f"unknown mode {mode!r}; expected probe, reprobe, extended or verification")
+
+
+def _run_of(runs: list[ProbeRun], run: str) -> ProbeRun | None:
+    """The probe run called ``run`` (a case id without replicate and load), or None."""
+    return next((r for r in runs if r.case == run), None)
+
+
+def _probe_setup(
+    test: str,
+    case: str,
+    point: dict[str, Any],
+    config: Mapping[str, Any],
+    candidates: list[Candidate],
+    found: ProbeRun,
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Case row and configuration of a probe run: its candidate at its level, or the model as
+    it is for a reference run."""
+    cand = next((c for c in candidates if c.name == found.candidate), None)
+    return case_setup(test, case, point, config, cand, found.level)
 
 
 def render_discrepancy_run(
